@@ -1,0 +1,1 @@
+//! Occupancy map data (owned by the mapping helper; see systems/src/mapping).

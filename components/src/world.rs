@@ -1,0 +1,1 @@
+//! World geometry data (owned by the world helper).

@@ -1,0 +1,3 @@
+//! uavex engine: scenario files, world building, the simulation loop, runs and their outputs.
+
+pub mod scenario;

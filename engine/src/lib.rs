@@ -1,3 +1,9 @@
 //! uavex engine: scenario files, world building, the simulation loop, runs and their outputs.
 
+pub mod formats;
+pub mod metrics;
+pub mod output;
+pub mod run;
 pub mod scenario;
+pub mod sim;
+pub mod world;

@@ -1,1 +1,7 @@
-
+//! uavex behaviour: one module per pipeline stage. Each module holds its algorithm as plain
+//! functions over plain data (unit-tested without a World) and the thin ECS systems that apply
+//! them.
+pub mod behaviour;
+pub mod mapping;
+pub mod sensing;
+pub mod stages;

@@ -2,13 +2,14 @@
 //! (z up, the floor at z = 0).
 //!
 //! Every table refuses unknown fields: a typo is an error, never a silently ignored setting.
+//! The types also serialize (same field names), so a run can record the scenario it ran.
 
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 /// One scenario file: a world, the UAVs in it and what they do.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scenario {
     pub name: String,
@@ -30,7 +31,7 @@ pub struct Scenario {
 }
 
 /// The occupancy map (common.md section 1; OctoMap defaults).
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MapSpec {
     /// Voxel edge length (m).
@@ -62,7 +63,7 @@ impl Default for MapSpec {
 }
 
 /// The mission volume and the obstacles in it.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorldSpec {
     /// Bounding box of the mission volume; the map covers exactly this box.
@@ -74,7 +75,7 @@ pub struct WorldSpec {
     pub obstacles: Vec<ObstacleSpec>,
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct BoundsSpec {
     pub min: [f64; 3],
@@ -82,12 +83,12 @@ pub struct BoundsSpec {
 }
 
 /// One obstacle, or a generator of many.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum ObstacleSpec {
     /// A box; `size` along its own axes, turned by `yaw` about +z.
     Box {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         center: [f64; 3],
         size: [f64; 3],
@@ -96,21 +97,21 @@ pub enum ObstacleSpec {
     },
     /// An upright cylinder standing on `base` (centre of its bottom disc).
     Cylinder {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         base: [f64; 3],
         radius: f64,
         height: f64,
     },
     Sphere {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         center: [f64; 3],
         radius: f64,
     },
     /// A triangle mesh from an OBJ or STL file (path relative to the scenario file).
     Mesh {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         file: PathBuf,
         #[serde(default)]
@@ -123,7 +124,7 @@ pub enum ObstacleSpec {
     /// A point cloud from a PCD or PLY file (ASCII or binary); each point is a ball of
     /// `point_radius`.
     Cloud {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         file: PathBuf,
         point_radius: f64,
@@ -134,7 +135,7 @@ pub enum ObstacleSpec {
     },
     /// Random upright pillars (tree trunks) in a rectangle of the floor, drawn from the run seed.
     Pillars {
-        #[serde(default)]
+        #[serde(default, skip_serializing_if = "Option::is_none")]
         name: Option<String>,
         /// Opposite corners (x, y) of the region.
         region_min: [f64; 2],
@@ -151,7 +152,7 @@ pub enum ObstacleSpec {
 }
 
 /// One UAV: where it starts, what it is, what it carries and what it does.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct UavSpec {
     pub name: String,
@@ -167,7 +168,7 @@ pub struct UavSpec {
     pub behaviour: BehaviourSpec,
 }
 
-#[derive(Debug, Clone, Copy, Deserialize)]
+#[derive(Debug, Clone, Copy, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StartSpec {
     pub position: [f64; 3],
@@ -176,7 +177,7 @@ pub struct StartSpec {
 }
 
 /// A range sensor on a UAV.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum SensorSpec {
     /// Pinhole depth camera looking along the mount's +x; vertical FoV follows from the aspect.
@@ -227,7 +228,7 @@ pub enum SensorSpec {
 }
 
 /// Pose of a sensor on its UAV (body frame: x forward, y left, z up).
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MountSpec {
     #[serde(default)]
@@ -239,7 +240,7 @@ pub struct MountSpec {
 
 /// Which rays a camera casts: `"auto"` (angular step = resolution / max range), or an explicit
 /// `[columns, rows]` grid (the camera resolution reproduces one ray per pixel).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(untagged)]
 pub enum RayGridSpec {
     Named(RayGridName),
@@ -252,17 +253,19 @@ impl Default for RayGridSpec {
     }
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum RayGridName {
     Auto,
 }
 
 /// Sensor quality; unset probabilities fall back to the map's defaults.
-#[derive(Debug, Clone, Copy, Default, Deserialize)]
+#[derive(Debug, Clone, Copy, Default, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct QualitySpec {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p_hit: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub p_miss: Option<f64>,
     /// Standard deviation of Gaussian range noise (m).
     #[serde(default)]
@@ -270,7 +273,7 @@ pub struct QualitySpec {
 }
 
 /// What a UAV does. Later kinds (waypoints with dynamics, exploration, coverage) are added here.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BehaviourSpec {
     /// Kinematic: the pose follows the waypoints at a constant speed, set directly each tick
@@ -287,7 +290,7 @@ pub enum BehaviourSpec {
 }
 
 /// What a run writes besides `summary.json`.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Rows per simulated second in the time series.

@@ -1,0 +1,182 @@
+//! One run from start to files: build, step to the end, summarise, write outputs. A run that
+//! fails (a panic anywhere in a system) is recorded as `failed` with its reason, and whatever
+//! was computed until then is still written.
+
+use crate::formats::{octomap, ply};
+use crate::metrics::{EXPLORED_THRESHOLDS, RunRecord};
+use crate::output::{RunSummary, UavSummary, map_series_csv, uav_series_csv, write_atomically};
+use crate::scenario::{self, LoadedScenario, ScenarioErrors};
+use crate::sim::Sim;
+use bevy_ecs::prelude::World;
+use bevy_ecs::system::SystemState;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+use uavex_components::map::{MapConfig, MapTotals};
+use uavex_components::sim::{Outcome, SimClock};
+use uavex_components::uav::{Uav, UavEnded};
+use uavex_components::world::WorldGeometry;
+use uavex_systems::mapping::{MapReader, OccupancyMap, map_accuracy};
+
+/// How to run a scenario.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Where to write the run's files; nothing is written when `None`.
+    pub out_dir: Option<PathBuf>,
+    /// Overrides the scenario's seed.
+    pub seed: Option<u64>,
+}
+
+/// Loads a scenario file and refuses it, with every problem located, if it cannot run as
+/// written (including the problems only the built world reveals).
+pub fn load_and_check(path: &Path) -> Result<LoadedScenario, ScenarioErrors> {
+    let loaded = scenario::load(path)?;
+    Sim::build(&loaded, loaded.scenario.seed)?;
+    Ok(loaded)
+}
+
+/// Loads, checks and runs a scenario file.
+pub fn run_file(path: &Path, options: &RunOptions) -> Result<RunSummary, ScenarioErrors> {
+    let loaded = scenario::load(path)?;
+    run(&loaded, options)
+}
+
+/// Runs a loaded scenario. `Err` only for a scenario the world builder refuses; once the run
+/// has started, every ending (including a panic) is a summary.
+pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, ScenarioErrors> {
+    let seed = options.seed.unwrap_or(loaded.scenario.seed);
+    let started = Instant::now();
+    let mut sim = Sim::build(loaded, seed)?;
+    let ending = catch_unwind(AssertUnwindSafe(|| sim.run_to_end()));
+    let (outcome, reason) = ending.unwrap_or_else(|panic| {
+        let message = panic
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| panic.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown panic");
+        (Outcome::Failed, format!("the run panicked: {message}"))
+    });
+    // The world may be mid-tick after a panic; what it recorded until then is still valid.
+    let mut summary = summarise(&mut sim, &loaded.scenario.name, seed, outcome, reason);
+    summary.wall_time_s = started.elapsed().as_secs_f64();
+    if let Some(dir) = &options.out_dir {
+        if let Err(e) = write_outputs(&mut sim, &summary, dir, loaded.scenario.outputs.export_map) {
+            summary.outcome = Outcome::Failed;
+            summary.reason = format!("could not write results to {}: {e}", dir.display());
+        }
+    }
+    Ok(summary)
+}
+
+/// The summary of a finished (or failed) run, from what the world holds.
+fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: String) -> RunSummary {
+    let world = &mut sim.world;
+    let time_s = world.resource::<SimClock>().time_s();
+    let ticks = world.resource::<SimClock>().tick;
+    let metrics = world
+        .resource::<MapTotals>()
+        .metrics(world.resource::<MapConfig>());
+    let accuracy = with_map(world, |reader, world| {
+        let geometry = world.resource::<WorldGeometry>();
+        let resolution = reader.config().resolution() as f32;
+        map_accuracy(reader, |key| geometry.voxel_key_occupied(key, resolution))
+    })
+    .flatten();
+    let mut uavs: Vec<(usize, String, Option<UavEnded>)> = world
+        .query::<(&Uav, Option<&UavEnded>)>()
+        .iter(world)
+        .map(|(uav, ended)| (uav.index, uav.name.clone(), ended.cloned()))
+        .collect();
+    uavs.sort_by_key(|(index, ..)| *index);
+    let mut record = world.resource_mut::<RunRecord>();
+    record.close(time_s, metrics);
+    let record = world.resource::<RunRecord>();
+    let [t50, t90, t95, t99] = record.threshold_times_s;
+    debug_assert_eq!(EXPLORED_THRESHOLDS.len(), 4);
+    RunSummary {
+        scenario: name.to_owned(),
+        seed,
+        outcome,
+        reason,
+        mission_time_s: time_s,
+        ticks,
+        explored_fraction: metrics.explored_fraction,
+        known_voxels: metrics.known_voxels,
+        occupied_voxels: metrics.occupied_voxels,
+        box_voxels: metrics.box_voxels,
+        entropy_known_bits: metrics.mean_entropy_known,
+        entropy_box_bits: metrics.mean_entropy_box,
+        uncertainty_total: metrics.uncertainty_total,
+        uncertainty_mean: metrics.uncertainty_mean,
+        uncertainty_free_mean: metrics.mean_uncertainty_free,
+        uncertainty_occupied_mean: metrics.mean_uncertainty_occupied,
+        map_accuracy: accuracy,
+        time_to_explored_50_s: t50,
+        time_to_explored_90_s: t90,
+        time_to_explored_95_s: t95,
+        time_to_explored_99_s: t99,
+        path_length_m: record.path_length_m.iter().sum(),
+        uavs: uavs
+            .into_iter()
+            .map(|(index, name, ended)| UavSummary {
+                name,
+                path_length_m: record.path_length_m[index],
+                status: match ended {
+                    None => "flying".to_owned(),
+                    Some(UavEnded::Finished) => "finished".to_owned(),
+                    Some(UavEnded::Crashed { .. }) => "crashed".to_owned(),
+                },
+            })
+            .collect(),
+        wall_time_s: 0.0,
+    }
+}
+
+/// Writes summary, series and (optionally) the map exports into `dir`.
+fn write_outputs(
+    sim: &mut Sim,
+    summary: &RunSummary,
+    dir: &Path,
+    export_map: bool,
+) -> std::io::Result<()> {
+    std::fs::create_dir_all(dir)?;
+    let world = &mut sim.world;
+    {
+        let record = world.resource::<RunRecord>();
+        write_atomically(
+            &dir.join("series.csv"),
+            map_series_csv(&record.map_rows).as_bytes(),
+        )?;
+        write_atomically(
+            &dir.join("uavs.csv"),
+            uav_series_csv(&record.uav_rows).as_bytes(),
+        )?;
+    }
+    if export_map {
+        let (bt, cloud) = with_map(world, |reader, _| -> std::io::Result<_> {
+            let config = reader.config();
+            let mut bt = Vec::new();
+            octomap::write_bt(&mut bt, config.resolution(), reader.known_voxels())?;
+            let occupied = reader
+                .known_voxels()
+                .filter(|&(_, l)| l >= 0.0)
+                .map(|(key, _)| config.center_of(key));
+            let mut cloud = Vec::new();
+            ply::write_points(&mut cloud, occupied)?;
+            Ok((bt, cloud))
+        })
+        .ok_or_else(|| std::io::Error::other("the map is not readable"))??;
+        write_atomically(&dir.join("map.bt"), &bt)?;
+        write_atomically(&dir.join("map_occupied.ply"), &cloud)?;
+    }
+    // The summary goes last: its presence marks a run whose files are all written.
+    let json = serde_json::to_vec_pretty(summary).map_err(std::io::Error::other)?;
+    write_atomically(&dir.join("summary.json"), &json)
+}
+
+/// Calls `f` with a read-only view of the map; `None` if the world holds no map.
+fn with_map<R>(world: &mut World, f: impl FnOnce(&MapReader, &World) -> R) -> Option<R> {
+    let mut state = SystemState::<MapReader>::new(world);
+    let reader = state.get(world).ok()?;
+    Some(f(&reader, world))
+}

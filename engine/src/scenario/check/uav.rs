@@ -1,0 +1,245 @@
+//! Checks of the UAVs: names, airframes, starts, behaviours and sensors (common.md §2-3).
+
+use std::f64::consts::PI;
+
+use super::world::{Context, check_hit_miss};
+use super::{
+    KNOWN_AIRFRAMES, MAX_RAYS_PER_SCAN, UavPart, angle, at_least_one, inside, non_negative,
+    positive, triple,
+};
+use crate::scenario::diagnostic::{Finding, number};
+use crate::scenario::path::FieldPath;
+use crate::scenario::schema::{
+    BehaviourSpec, BoundsSpec, QualitySpec, RayGridSpec, SensorSpec, UavSpec,
+};
+use crate::scenario::source_map::Anchor;
+use crate::scenario::suggest::{closest, plain_list};
+
+/// UAV names identify UAVs in outputs: no two may share one.
+pub(crate) fn check_names(uavs: &[UavPart<'_>], out: &mut Vec<Finding>) {
+    let mut seen: Vec<(&str, usize)> = Vec::new();
+    for part in uavs {
+        let Some(spec) = part.spec else { continue };
+        if let Some((_, first)) = seen.iter().find(|(name, _)| *name == spec.name) {
+            out.push(Finding::must_be(
+                FieldPath::root().key("uav").index(part.index).key("name"),
+                format!(
+                    "a name no other UAV has (uav[{first}] is also called {:?})",
+                    spec.name
+                ),
+                format!("{:?}", spec.name),
+            ));
+        } else {
+            seen.push((&spec.name, part.index));
+        }
+    }
+}
+
+/// One UAV without its sensors.
+pub(crate) fn check_uav(
+    path: &FieldPath,
+    uav: &UavSpec,
+    context: &Context,
+    out: &mut Vec<Finding>,
+) {
+    if uav.name.trim().is_empty() {
+        out.push(Finding::must_be(
+            path.key("name"),
+            "a non-empty name",
+            format!("{:?}", uav.name),
+        ));
+    }
+    if !KNOWN_AIRFRAMES.contains(&uav.airframe.as_str()) {
+        let known = plain_list(KNOWN_AIRFRAMES);
+        let mut message = format!(
+            "unknown airframe preset '{}': this build knows: {known}",
+            uav.airframe
+        );
+        if let Some(near) = closest(&uav.airframe, KNOWN_AIRFRAMES) {
+            message.push_str(&format!(" (did you mean '{near}'?)"));
+        }
+        out.push(
+            Finding::new(path.key("airframe"), Anchor::Value, message)
+                .expected(format!("one of: {known}")),
+        );
+    }
+    if let Some(bounds) = &context.bounds
+        && !inside(uav.start.position, bounds.min, bounds.max)
+    {
+        out.push(Finding::must_be(
+            path.key("start").key("position"),
+            within(bounds),
+            triple(uav.start.position),
+        ));
+    }
+    check_behaviour(&path.key("behaviour"), &uav.behaviour, context, out);
+}
+
+fn within(bounds: &BoundsSpec) -> String {
+    format!(
+        "inside world.bounds ({} to {})",
+        triple(bounds.min),
+        triple(bounds.max)
+    )
+}
+
+fn check_behaviour(
+    path: &FieldPath,
+    behaviour: &BehaviourSpec,
+    context: &Context,
+    out: &mut Vec<Finding>,
+) {
+    match behaviour {
+        BehaviourSpec::Scripted {
+            speed,
+            waypoints,
+            yaw_rate,
+        } => {
+            positive(out, path.key("speed"), *speed);
+            positive(out, path.key("yaw_rate"), *yaw_rate);
+            if waypoints.is_empty() {
+                out.push(Finding::must_be(
+                    path.key("waypoints"),
+                    "at least one waypoint",
+                    "an empty list",
+                ));
+            }
+            if let Some(bounds) = &context.bounds {
+                for (k, waypoint) in waypoints.iter().enumerate() {
+                    if !inside(*waypoint, bounds.min, bounds.max) {
+                        out.push(Finding::must_be(
+                            path.key("waypoints").index(k),
+                            within(bounds),
+                            triple(*waypoint),
+                        ));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// One sensor (common.md §2).
+pub(crate) fn check_sensor(
+    path: &FieldPath,
+    sensor: &SensorSpec,
+    context: &Context,
+    out: &mut Vec<Finding>,
+) {
+    match sensor {
+        SensorSpec::DepthCamera {
+            width,
+            height,
+            hfov,
+            range_min,
+            range_max,
+            rate_hz,
+            ray_grid,
+            quality,
+            ..
+        } => {
+            at_least_one(out, path.key("width"), *width);
+            at_least_one(out, path.key("height"), *height);
+            angle(out, path.key("hfov"), *hfov, PI, true);
+            check_ranges(path, *range_min, *range_max, out);
+            positive(out, path.key("rate_hz"), *rate_hz);
+            check_quality(path, quality, out);
+            let rays = match ray_grid {
+                RayGridSpec::Explicit([columns, rows]) => {
+                    at_least_one(out, path.key("ray_grid").index(0), *columns);
+                    at_least_one(out, path.key("ray_grid").index(1), *rows);
+                    Some(f64::from(*columns) * f64::from(*rows))
+                }
+                RayGridSpec::Named(_) => {
+                    auto_grid_rays(*width, *height, *hfov, *range_max, context)
+                }
+            };
+            check_ray_count(&path.key("ray_grid"), rays, out);
+        }
+        SensorSpec::Lidar {
+            hfov,
+            beams_h,
+            vfov,
+            beams_v,
+            range_min,
+            range_max,
+            rate_hz,
+            quality,
+            ..
+        } => {
+            angle(out, path.key("hfov"), *hfov, 2.0 * PI, false);
+            at_least_one(out, path.key("beams_h"), *beams_h);
+            at_least_one(out, path.key("beams_v"), *beams_v);
+            if *beams_v > 1 {
+                angle(out, path.key("vfov"), *vfov, PI, true);
+            } else if *vfov != 0.0 && vfov.is_finite() {
+                out.push(Finding::must_be(
+                    path.key("vfov"),
+                    "0 for a planar lidar (beams_v = 1); set beams_v for a multi-beam one",
+                    number(*vfov),
+                ));
+            }
+            check_ranges(path, *range_min, *range_max, out);
+            positive(out, path.key("rate_hz"), *rate_hz);
+            check_quality(path, quality, out);
+            check_ray_count(
+                &path.key("beams_h"),
+                Some(f64::from(*beams_h) * f64::from(*beams_v)),
+                out,
+            );
+        }
+    }
+}
+
+/// 0 <= range_min < range_max.
+fn check_ranges(path: &FieldPath, range_min: f64, range_max: f64, out: &mut Vec<Finding>) {
+    non_negative(out, path.key("range_min"), range_min);
+    positive(out, path.key("range_max"), range_max);
+    if range_min >= 0.0 && range_max > 0.0 && range_min >= range_max {
+        out.push(Finding::must_be(
+            path.key("range_min"),
+            format!("below range_max ({})", number(range_max)),
+            number(range_min),
+        ));
+    }
+}
+
+fn check_quality(sensor: &FieldPath, quality: &QualitySpec, out: &mut Vec<Finding>) {
+    let path = sensor.key("quality");
+    check_hit_miss(&path, quality.p_hit, quality.p_miss, out);
+    non_negative(out, path.key("range_noise_std"), quality.range_noise_std);
+}
+
+/// Rays per frame of the "auto" grid, estimated as the sensing stage builds it (common.md §2:
+/// angular step = resolution / range_max over the horizontal and vertical FoV, the vertical one
+/// following from the aspect ratio); `None` when the inputs are themselves invalid.
+fn auto_grid_rays(
+    width: u32,
+    height: u32,
+    hfov: f64,
+    range_max: f64,
+    context: &Context,
+) -> Option<f64> {
+    let resolution = context.map.as_ref()?.resolution;
+    let valid = width > 0 && height > 0 && hfov > 0.0 && hfov < PI && range_max > 0.0;
+    if !(valid && range_max.is_finite()) {
+        return None;
+    }
+    let step = resolution / range_max;
+    let vfov = 2.0 * ((hfov / 2.0).tan() * f64::from(height) / f64::from(width)).atan();
+    Some(((hfov / step).ceil() + 1.0) * ((vfov / step).ceil() + 1.0))
+}
+
+fn check_ray_count(path: &FieldPath, rays: Option<f64>, out: &mut Vec<Finding>) {
+    if let Some(rays) = rays
+        && rays > MAX_RAYS_PER_SCAN
+    {
+        out.push(Finding::must_be(
+            path.clone(),
+            format!(
+                "a ray grid of at most {MAX_RAYS_PER_SCAN:e} rays per scan (for the auto grid: a coarser map.resolution or a shorter range_max)"
+            ),
+            format!("{rays:.3e} rays"),
+        ));
+    }
+}

@@ -1,0 +1,182 @@
+//! The simulation of one run: a bevy `World` built from one scenario and one seed, and the
+//! `Tick` schedule with the pipeline stages (DESIGN.md "One tick").
+
+use crate::metrics::{RunRecord, record_metrics};
+use crate::scenario::{BehaviourSpec, LoadedScenario, ScenarioErrors};
+use crate::world::{build_world, check_starts, sensor_bundle};
+use bevy_ecs::prelude::*;
+use bevy_ecs::system::ScheduleSystem;
+use glam::{DVec3, Vec3};
+use uavex_components::map::{MapConfig, MapSettings};
+use uavex_components::sensor::SensorId;
+use uavex_components::sim::{Outcome, RunEnd, RunSeed, SimClock};
+use uavex_components::uav::{QuadState, Uav, UavEnded};
+use uavex_systems::behaviour::scripted::{ScriptedRoute, fly_scripted};
+use uavex_systems::mapping::{insert_map_resources, integrate_scans};
+use uavex_systems::sensing::sense;
+use uavex_systems::stages::{Stage, tick_schedule};
+
+/// Radius of the ball a UAV must fit in at its start (m): the kingfisher's arms (0.125 m to the
+/// rotor axes, common.md §3) plus a 5 cm rotor. Airframe data will supply it per UAV.
+pub const START_CLEARANCE_RADIUS: f32 = 0.175;
+
+/// One run in progress.
+pub struct Sim {
+    pub world: World,
+    schedule: Schedule,
+    time_limit_s: f64,
+}
+
+fn vec3(v: [f64; 3]) -> Vec3 {
+    DVec3::from_array(v).as_vec3()
+}
+
+impl Sim {
+    /// Builds the world of `loaded` for `seed`: geometry, map, UAVs with their sensors and
+    /// behaviours, and the tick schedule. Problems that need the geometry (a missing mesh file,
+    /// a start inside an obstacle) come back located in the scenario file.
+    pub fn build(loaded: &LoadedScenario, seed: u64) -> Result<Sim, ScenarioErrors> {
+        let scenario = &loaded.scenario;
+        let run_seed = RunSeed(seed);
+        let locate = |errors: Vec<crate::world::BuildError>| {
+            loaded.errors(errors.into_iter().map(|e| (e.path, e.message)))
+        };
+        let starts: Vec<Vec3> = scenario
+            .uavs
+            .iter()
+            .map(|u| vec3(u.start.position))
+            .collect();
+        let geometry =
+            build_world(&scenario.world, run_seed, &starts, &loaded.base_dir).map_err(locate)?;
+        let start_problems = check_starts(&geometry, &starts, START_CLEARANCE_RADIUS);
+        if !start_problems.is_empty() {
+            return Err(locate(start_problems));
+        }
+        let map = MapConfig::new(&MapSettings {
+            resolution: scenario.map.resolution,
+            bounds_min: DVec3::from_array(scenario.world.bounds.min),
+            bounds_max: DVec3::from_array(scenario.world.bounds.max),
+            p_min: scenario.map.p_min,
+            p_max: scenario.map.p_max,
+        })
+        .map_err(|e| loaded.errors([("map", e.to_string())]))?;
+
+        let mut world = World::new();
+        world.insert_resource(SimClock::new(scenario.physics_rate_hz));
+        world.insert_resource(run_seed);
+        world.insert_resource(RunEnd::default());
+        world.insert_resource(geometry);
+        world.insert_resource(RunRecord::new(
+            scenario.outputs.series_rate_hz,
+            scenario.uavs.len(),
+        ));
+        insert_map_resources(&mut world, map);
+
+        let mut problems = Vec::new();
+        let mut next_sensor_id = 0;
+        for (index, spec) in scenario.uavs.iter().enumerate() {
+            let state = QuadState::at_rest(starts[index], spec.start.yaw as f32);
+            let uav = world
+                .spawn((
+                    Uav {
+                        name: spec.name.clone(),
+                        index,
+                    },
+                    state,
+                ))
+                .id();
+            match &spec.behaviour {
+                BehaviourSpec::Scripted {
+                    speed,
+                    waypoints,
+                    yaw_rate,
+                } => {
+                    world.entity_mut(uav).insert(ScriptedRoute {
+                        waypoints: waypoints.iter().map(|&w| vec3(w)).collect(),
+                        speed: *speed as f32,
+                        yaw_rate: *yaw_rate as f32,
+                        next: 0,
+                    });
+                }
+            }
+            for (j, sensor) in spec.sensors.iter().enumerate() {
+                let field = format!("uav[{index}].sensor[{j}]");
+                let id = SensorId(next_sensor_id);
+                next_sensor_id += 1;
+                match sensor_bundle(sensor, &scenario.map, uav, id, run_seed, &field) {
+                    Ok(bundle) => {
+                        world.spawn(bundle);
+                    }
+                    Err(e) => problems.push(e),
+                }
+            }
+        }
+        if !problems.is_empty() {
+            return Err(locate(problems));
+        }
+
+        let mut schedule = tick_schedule();
+        schedule.add_systems((
+            sense.in_set(Stage::Sense),
+            integrate_scans.in_set(Stage::Map),
+            fly_scripted.in_set(Stage::Control),
+            (record_metrics, end_when_every_uav_is_done)
+                .chain()
+                .in_set(Stage::Account),
+        ));
+        Ok(Sim {
+            world,
+            schedule,
+            time_limit_s: scenario.time_limit_s,
+        })
+    }
+
+    /// Adds systems to the tick (how users and later behaviours extend a run).
+    pub fn add_systems<M>(&mut self, systems: impl IntoScheduleConfigs<ScheduleSystem, M>) {
+        self.schedule.add_systems(systems);
+    }
+
+    /// Runs one tick (all stages) and advances the clock by one step.
+    pub fn step(&mut self) {
+        self.schedule.run(&mut self.world);
+        self.world.resource_mut::<SimClock>().tick += 1;
+    }
+
+    /// Simulated time (s).
+    pub fn time_s(&self) -> f64 {
+        self.world.resource::<SimClock>().time_s()
+    }
+
+    /// How the run ended, if it has.
+    pub fn ended(&self) -> Option<&(Outcome, String)> {
+        self.world.resource::<RunEnd>().0.as_ref()
+    }
+
+    /// Steps until a system ends the run or the time limit is reached.
+    pub fn run_to_end(&mut self) -> (Outcome, String) {
+        loop {
+            if let Some(end) = self.ended() {
+                return end.clone();
+            }
+            if self.time_s() >= self.time_limit_s {
+                let reason = format!("time limit of {} s reached", self.time_limit_s);
+                self.world.resource_mut::<RunEnd>().0 = Some((Outcome::TimeLimit, reason.clone()));
+                return (Outcome::TimeLimit, reason);
+            }
+            self.step();
+        }
+    }
+}
+
+/// Account stage: the run is complete once every UAV has ended its behaviour.
+pub fn end_when_every_uav_is_done(
+    mut run_end: ResMut<RunEnd>,
+    uavs: Query<Has<UavEnded>, With<Uav>>,
+) {
+    if run_end.0.is_none() && !uavs.is_empty() && uavs.iter().all(|ended| ended) {
+        run_end.0 = Some((
+            Outcome::Complete,
+            "every UAV completed its behaviour".to_owned(),
+        ));
+    }
+}

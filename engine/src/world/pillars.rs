@@ -1,0 +1,326 @@
+//! The seeded `pillars` generator: random upright pillars (tree trunks) on a rectangle of the
+//! floor.
+//!
+//! Model: a homogeneous Poisson point process of intensity `density` (pillars per square metre)
+//! on the region: the count is Poisson(density x area), positions uniform, radii uniform in
+//! [radius_min, radius_max]. This is the usual model of a random forest, and it makes `density`
+//! the true expected number per square metre whatever the area. Pillars may overlap (their union
+//! is the obstacle). Pillars closer than `start_clearance` to a UAV start are then removed, which
+//! leaves the process unchanged outside those discs.
+//!
+//! Randomness: `RunSeed::stream(stream::WORLD_GENERATOR, i)` for the generator at
+//! `world.obstacle[i]`; the count is drawn first, then per pillar x, y and radius, so one
+//! generator's pillars depend on the seed and its own parameters only.
+
+use super::primitives::upright_cylinder;
+use super::{BuildError, display_name, require_finite, require_positive};
+use crate::scenario::ObstacleSpec;
+use glam::{Vec2, Vec3};
+use rand::Rng;
+use rand_distr::{Distribution, Poisson};
+use uavex_components::sim::{RunSeed, stream};
+use uavex_components::world::Obstacle;
+
+/// More pillars than this from one generator is refused as a configuration mistake (a density
+/// meant per hectare, say); a million cylinders would make world building alone take seconds.
+pub const MAX_EXPECTED_PILLARS: f64 = 1e6;
+
+/// The parameters of one generator, checked.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PillarField {
+    pub region_min: Vec2,
+    pub region_max: Vec2,
+    pub density: f64,
+    pub radius_min: f32,
+    pub radius_max: f32,
+    pub height: f32,
+    pub start_clearance: f32,
+}
+
+/// One generated pillar: standing on (x, y, 0).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pillar {
+    pub base: Vec2,
+    pub radius: f32,
+}
+
+/// Draws the pillars of `field` from `rng`, without those closer than `start_clearance` to a
+/// start (distance from the start to the pillar's solid, in 3D).
+/// A region or radius range that is empty (or NaN) gives no pillars.
+pub fn generate_pillars(field: &PillarField, starts: &[Vec3], rng: &mut impl Rng) -> Vec<Pillar> {
+    let drawable = field.region_min.x < field.region_max.x
+        && field.region_min.y < field.region_max.y
+        && field.radius_min <= field.radius_max;
+    if !drawable {
+        return Vec::new();
+    }
+    let extent = field.region_max - field.region_min;
+    let mean = field.density * f64::from(extent.x) * f64::from(extent.y);
+    let count = Poisson::new(mean).map_or(0, |p| p.sample(rng) as u64);
+    let mut pillars = Vec::with_capacity(count as usize);
+    for _ in 0..count {
+        let base = Vec2::new(
+            rng.random_range(field.region_min.x..field.region_max.x),
+            rng.random_range(field.region_min.y..field.region_max.y),
+        );
+        let radius = rng.random_range(field.radius_min..=field.radius_max);
+        let pillar = Pillar { base, radius };
+        if starts
+            .iter()
+            .all(|s| distance_to_pillar(*s, &pillar, field.height) >= field.start_clearance)
+        {
+            pillars.push(pillar);
+        }
+    }
+    pillars
+}
+
+/// Distance from `point` to the solid cylinder of `pillar` (0 inside).
+fn distance_to_pillar(point: Vec3, pillar: &Pillar, height: f32) -> f32 {
+    let radial = (point.truncate().distance(pillar.base) - pillar.radius).max(0.0);
+    let vertical = (point.z - height).max(-point.z).max(0.0);
+    radial.hypot(vertical)
+}
+
+/// The pillars of the generator at `world.obstacle[index]`, as obstacles named `"{name} #{k}"`.
+pub(super) fn build(
+    spec: &ObstacleSpec,
+    index: usize,
+    field_path: &str,
+    seed: RunSeed,
+    starts: &[Vec3],
+) -> Result<Vec<Obstacle>, Vec<BuildError>> {
+    let ObstacleSpec::Pillars {
+        name,
+        region_min,
+        region_max,
+        density,
+        radius_min,
+        radius_max,
+        height,
+        start_clearance,
+    } = spec
+    else {
+        return Err(vec![BuildError::new(
+            field_path,
+            "internal: not a pillars generator",
+        )]);
+    };
+    let mut errors = Vec::new();
+    require_finite(&mut errors, format!("{field_path}.region_min"), region_min);
+    require_finite(&mut errors, format!("{field_path}.region_max"), region_max);
+    // Compared in f32, the precision positions are drawn in (an empty f32 range cannot be drawn).
+    let (lo, hi) = (region_min.map(|v| v as f32), region_max.map(|v| v as f32));
+    if errors.is_empty() && !(lo[0] < hi[0] && lo[1] < hi[1]) {
+        errors.push(BuildError::new(
+            format!("{field_path}.region_max"),
+            format!("must exceed region_min {region_min:?} on both axes, got {region_max:?}"),
+        ));
+    }
+    if !(density.is_finite() && *density >= 0.0) {
+        errors.push(BuildError::new(
+            format!("{field_path}.density"),
+            format!("must be finite and >= 0, got {density}"),
+        ));
+    }
+    require_positive(&mut errors, format!("{field_path}.radius_min"), *radius_min);
+    require_positive(&mut errors, format!("{field_path}.radius_max"), *radius_max);
+    if radius_min > radius_max {
+        errors.push(BuildError::new(
+            format!("{field_path}.radius_max"),
+            format!("must be >= radius_min ({radius_min}), got {radius_max}"),
+        ));
+    }
+    require_positive(&mut errors, format!("{field_path}.height"), *height);
+    if !(start_clearance.is_finite() && *start_clearance >= 0.0) {
+        errors.push(BuildError::new(
+            format!("{field_path}.start_clearance"),
+            format!("must be finite and >= 0, got {start_clearance}"),
+        ));
+    }
+    if !errors.is_empty() {
+        return Err(errors);
+    }
+    let area = (region_max[0] - region_min[0]) * (region_max[1] - region_min[1]);
+    if density * area > MAX_EXPECTED_PILLARS {
+        return Err(vec![BuildError::new(
+            format!("{field_path}.density"),
+            format!(
+                "{density} per m^2 over {area} m^2 expects {} pillars, more than the limit of \
+                 {MAX_EXPECTED_PILLARS}",
+                density * area
+            ),
+        )]);
+    }
+    let field = PillarField {
+        region_min: Vec2::new(region_min[0] as f32, region_min[1] as f32),
+        region_max: Vec2::new(region_max[0] as f32, region_max[1] as f32),
+        density: *density,
+        radius_min: *radius_min as f32,
+        radius_max: *radius_max as f32,
+        height: *height as f32,
+        start_clearance: *start_clearance as f32,
+    };
+    let mut rng = seed.stream(stream::WORLD_GENERATOR, index as u64);
+    let base_name = display_name(name, "pillars", index);
+    Ok(generate_pillars(&field, starts, &mut rng)
+        .into_iter()
+        .enumerate()
+        .map(|(k, p)| {
+            upright_cylinder(
+                format!("{base_name} #{k}"),
+                field_path,
+                p.base.extend(0.0),
+                p.radius,
+                field.height,
+            )
+        })
+        .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::WorldSpec;
+    use std::path::Path;
+
+    /// 20 x 20 m centred on the origin, 0.1 pillars / m^2, all of radius 0.2 and height 3.
+    const FIELD: PillarField = PillarField {
+        region_min: Vec2::new(-10.0, -10.0),
+        region_max: Vec2::new(10.0, 10.0),
+        density: 0.1,
+        radius_min: 0.2,
+        radius_max: 0.2,
+        height: 3.0,
+        start_clearance: 1.0,
+    };
+    const START: Vec3 = Vec3::new(0.0, 0.0, 1.0);
+
+    fn draw(seed: u64, field: &PillarField, starts: &[Vec3]) -> Vec<Pillar> {
+        let mut rng = RunSeed(seed).stream(stream::WORLD_GENERATOR, 0);
+        generate_pillars(field, starts, &mut rng)
+    }
+
+    #[test]
+    fn same_seed_same_pillars_other_seed_other_pillars() {
+        let a = draw(42, &FIELD, &[START]);
+        assert!(!a.is_empty());
+        assert_eq!(a, draw(42, &FIELD, &[START]));
+        assert_ne!(a, draw(43, &FIELD, &[START]));
+        // Through the builder: the generator's stream is keyed by its obstacle index.
+        let spec: WorldSpec = toml::from_str(
+            r#"
+            bounds = { min = [-10, -10, 0], max = [10, 10, 3] }
+            [[obstacle]]
+            kind = "pillars"
+            name = "forest"
+            region_min = [-10, -10]
+            region_max = [10, 10]
+            density = 0.1
+            radius_min = 0.1
+            radius_max = 0.3
+            height = 3
+            "#,
+        )
+        .unwrap();
+        let build = |seed| {
+            super::super::build_world(&spec, RunSeed(seed), &[START], Path::new(".")).unwrap()
+        };
+        let poses = |w: &uavex_components::world::WorldGeometry| {
+            w.obstacles().iter().map(|o| o.pose).collect::<Vec<_>>()
+        };
+        let (w1, w2, w3) = (build(7), build(7), build(8));
+        assert_eq!(poses(&w1), poses(&w2));
+        assert_ne!(poses(&w1), poses(&w3));
+        assert_eq!(w1.obstacles()[1].name, "forest #0");
+        assert_eq!(w1.obstacles()[1].source, "world.obstacle[0]");
+        // Each pillar stands on the floor and reaches 3 m: a ray down onto its axis from 5 m
+        // meets its top 2 m below.
+        let axis = w1.obstacles()[1].pose.translation;
+        assert!((axis.z - 1.5).abs() < 1e-6);
+        let d = w1.cast_ray(Vec3::new(axis.x, axis.y, 5.0), -Vec3::Z, 10.0);
+        assert!((d.unwrap() - 2.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn density_is_respected_within_poisson_bounds() {
+        // Expected count: 0.1 x (400 - pi (1.0 + 0.2)^2) = 39.548 (the start's exclusion disc
+        // reaches the clearance plus the radius from the axis). Over 400 seeds the mean has a
+        // standard deviation of sqrt(39.548 / 400) = 0.314; allow 4 of them. A Poisson count
+        // has variance = mean: allow the sample's dispersion 25 % either way (~3.5 sigma).
+        let expected = 0.1 * (400.0 - std::f64::consts::PI * 1.2f64.powi(2));
+        let counts: Vec<f64> = (0..400)
+            .map(|seed| draw(seed, &FIELD, &[START]).len() as f64)
+            .collect();
+        let mean = counts.iter().sum::<f64>() / 400.0;
+        let var = counts.iter().map(|c| (c - mean).powi(2)).sum::<f64>() / 399.0;
+        assert!(
+            (mean - expected).abs() < 4.0 * (expected / 400.0).sqrt(),
+            "{mean}"
+        );
+        assert!((var / mean - 1.0).abs() < 0.25, "dispersion {}", var / mean);
+        // Positions uniform: mean x and y near 0 (std of one coordinate 20 / sqrt(12) = 5.77,
+        // over ~15,800 pillars 0.046: allow 0.2).
+        let all: Vec<Pillar> = (0..400).flat_map(|s| draw(s, &FIELD, &[START])).collect();
+        let mean_x = all.iter().map(|p| p.base.x).sum::<f32>() / all.len() as f32;
+        let mean_y = all.iter().map(|p| p.base.y).sum::<f32>() / all.len() as f32;
+        assert!(
+            mean_x.abs() < 0.2 && mean_y.abs() < 0.2,
+            "{mean_x} {mean_y}"
+        );
+    }
+
+    #[test]
+    fn clearance_is_kept_from_every_start_in_3d() {
+        let starts = [START, Vec3::new(5.0, 5.0, 1.5), Vec3::new(-5.0, 5.0, 4.5)];
+        let field = PillarField {
+            density: 0.5,
+            radius_min: 0.1,
+            radius_max: 0.5,
+            start_clearance: 1.5,
+            ..FIELD
+        };
+        let mut below_high_start = 0;
+        for seed in 0..50 {
+            for p in draw(seed, &field, &starts) {
+                for s in &starts[..2] {
+                    assert!(s.truncate().distance(p.base) - p.radius >= 1.5 - 1e-5);
+                }
+                // The third start is 1.5 m above the pillar tops (z = 3): pillars right below
+                // it are 1.5 m away, exactly the clearance, and may stand.
+                if starts[2].truncate().distance(p.base) < p.radius {
+                    below_high_start += 1;
+                }
+            }
+        }
+        assert!(below_high_start > 0);
+        // With a clearance covering the whole region nothing is placed.
+        let none = PillarField {
+            start_clearance: 30.0,
+            ..FIELD
+        };
+        assert!(draw(1, &none, &[START]).is_empty());
+    }
+
+    #[test]
+    fn absurd_densities_are_refused() {
+        let spec: WorldSpec = toml::from_str(
+            r#"
+            bounds = { min = [-10, -10, 0], max = [10, 10, 3] }
+            [[obstacle]]
+            kind = "pillars"
+            region_min = [-1000, -1000]
+            region_max = [1000, 1000]
+            density = 1.0
+            radius_min = 0.1
+            radius_max = 0.3
+            height = 3
+            "#,
+        )
+        .unwrap();
+        let errors =
+            super::super::build_world(&spec, RunSeed(0), &[START], Path::new(".")).unwrap_err();
+        assert_eq!(errors[0].path, "world.obstacle[0].density");
+        assert!(errors[0].message.contains("4000000"), "{}", errors[0]);
+    }
+}

@@ -1,0 +1,352 @@
+//! Voxel traversal of a segment: Amanatides & Woo's 3D DDA ("A Fast Voxel Traversal Algorithm
+//! for Ray Tracing", 1987), as common.md §1 prescribes, in voxel units (`p / resolution`, so
+//! voxel `k` spans `[k, k + 1)` on each axis).
+//!
+//! The segment is first clipped to the map's key box (slab test), so the traversal itself never
+//! checks bounds. The walk then takes exactly `|Δkey|_1` steps, one axis at a time, always the
+//! axis whose next boundary the segment crosses first; an axis that has reached the end key
+//! is retired. This makes the walk end exactly on the end key whatever the floating-point
+//! rounding, and the path is 6-connected (a ray through an edge or corner visits one of the
+//! voxels beside it too, which is conservative for free space).
+
+use glam::{DVec3, IVec3};
+
+/// Stand-in for "never" in the boundary times of retired axes.
+const NEVER: f64 = f64::INFINITY;
+/// Cap on finite boundary times: an axis the segment barely moves along gets huge but finite
+/// times, so even after 2^37 steps its time stays below [`NEVER`] and the walk always picks an
+/// axis that still has steps left.
+const TIME_CAP: f64 = 1e290;
+
+/// A segment clipped to a key box: the keys it starts and ends in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ClippedSegment {
+    pub start_key: IVec3,
+    pub end_key: IVec3,
+    /// Whether the segment's own end point lies in the box (else it was cut at the box).
+    pub end_inside: bool,
+}
+
+/// Clips the segment `start -> end` (voxel units) to the keys `lo..=hi`; `None` if it misses the
+/// box (or only grazes its surface from outside).
+pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<ClippedSegment> {
+    let inside = |k: IVec3| k.cmpge(lo).all() && k.cmple(hi).all();
+    let d = end - start;
+    let (box_lo, box_hi) = (lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+    let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+    for axis in 0..3 {
+        if d[axis] == 0.0 {
+            if start[axis] < box_lo[axis] || start[axis] >= box_hi[axis] {
+                return None;
+            }
+        } else {
+            let ta = (box_lo[axis] - start[axis]) / d[axis];
+            let tb = (box_hi[axis] - start[axis]) / d[axis];
+            t0 = t0.max(ta.min(tb));
+            t1 = t1.min(ta.max(tb));
+        }
+    }
+    let (raw_start, raw_end) = (start.floor().as_ivec3(), end.floor().as_ivec3());
+    let (start_inside, end_inside) = (inside(raw_start), inside(raw_end));
+    if t0 > t1 || (t0 == t1 && !start_inside && !end_inside) {
+        return None;
+    }
+    // Points on the segment keep their key when inside (the same `floor` every key
+    // computation uses); entry and exit points are clamped into the box against rounding.
+    let key_at = |t: f64| (start + d * t).floor().as_ivec3().clamp(lo, hi);
+    Some(ClippedSegment {
+        start_key: if start_inside { raw_start } else { key_at(t0) },
+        end_key: if end_inside { raw_end } else { key_at(t1) },
+        end_inside,
+    })
+}
+
+/// The state of a traversal from `start_key` to `end_key` along the segment `start -> end`.
+#[derive(Debug, Clone, Copy)]
+pub struct VoxelWalk {
+    key: IVec3,
+    /// Segment parameter at which the next boundary on each axis is crossed.
+    t_max: [f64; 3],
+    /// Parameter increment between boundaries on each axis (1 / |d|).
+    t_delta: [f64; 3],
+    step: [i32; 3],
+    remaining: [u32; 3],
+}
+
+impl VoxelWalk {
+    /// A walk over the keys of a clipped segment (`start`, `end` are the unclipped points that
+    /// parametrise it; the keys need not be the keys of those points).
+    pub fn new(start: DVec3, end: DVec3, start_key: IVec3, end_key: IVec3) -> Self {
+        let d = end - start;
+        let mut walk = Self {
+            key: start_key,
+            t_max: [NEVER; 3],
+            t_delta: [NEVER; 3],
+            step: [0; 3],
+            remaining: [0; 3],
+        };
+        for axis in 0..3 {
+            let n = end_key[axis] - start_key[axis];
+            if n == 0 || d[axis] == 0.0 {
+                continue;
+            }
+            let boundary = f64::from(start_key[axis] + i32::from(n > 0));
+            walk.step[axis] = n.signum();
+            walk.remaining[axis] = n.unsigned_abs();
+            walk.t_max[axis] = ((boundary - start[axis]) / d[axis]).min(TIME_CAP);
+            walk.t_delta[axis] = (1.0 / d[axis].abs()).min(TIME_CAP);
+        }
+        walk
+    }
+
+    /// The current key.
+    #[inline]
+    pub fn key(&self) -> IVec3 {
+        self.key
+    }
+
+    /// Steps left until the end key.
+    pub fn steps_left(&self) -> u64 {
+        self.remaining.iter().map(|&r| u64::from(r)).sum()
+    }
+
+    /// Moves to the next voxel; returns the axis moved along and the step (+1 or -1).
+    /// Only meaningful while [`Self::steps_left`] > 0.
+    #[inline(always)]
+    pub fn step(&mut self) -> (usize, i32) {
+        let t = &self.t_max;
+        let axis = if t[0] <= t[1] {
+            if t[0] <= t[2] { 0 } else { 2 }
+        } else if t[1] <= t[2] {
+            1
+        } else {
+            2
+        };
+        self.t_max[axis] += self.t_delta[axis];
+        self.remaining[axis] = self.remaining[axis].saturating_sub(1);
+        if self.remaining[axis] == 0 {
+            self.t_max[axis] = NEVER;
+        }
+        let step = self.step[axis];
+        self.key[axis] += step;
+        (axis, step)
+    }
+}
+
+/// Visits every key of the segment `start -> end` (voxel units) inside `lo..=hi`, in order,
+/// including the end key: the plain form of the traversal for callers outside the map update
+/// (line-of-sight checks, tests).
+pub fn for_each_key(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3, mut visit: impl FnMut(IVec3)) {
+    let Some(clip) = clip_segment(start, end, lo, hi) else {
+        return;
+    };
+    let mut walk = VoxelWalk::new(start, end, clip.start_key, clip.end_key);
+    visit(walk.key());
+    for _ in 0..walk.steps_left() {
+        walk.step();
+        visit(walk.key());
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+    use std::collections::BTreeSet;
+
+    const LO: IVec3 = IVec3::splat(-20);
+    const HI: IVec3 = IVec3::splat(19);
+    /// Sampling step of the brute-force reference (voxel units).
+    const SAMPLE: f64 = 2e-4;
+
+    fn keys(start: DVec3, end: DVec3) -> Vec<IVec3> {
+        let mut out = Vec::new();
+        for_each_key(start, end, LO, HI, |k| out.push(k));
+        out
+    }
+
+    /// Keys of points sampled every `SAMPLE` along the segment (and its end), inside the box.
+    fn sampled(start: DVec3, end: DVec3) -> BTreeSet<[i32; 3]> {
+        let n = ((end - start).length() / SAMPLE).ceil().max(1.0) as usize;
+        (0..=n)
+            // start + d t (not `lerp`, whose (1 - t) a + t b drifts off a face the ray lies on)
+            .map(|i| {
+                (start + (end - start) * (i as f64 / n as f64))
+                    .floor()
+                    .as_ivec3()
+            })
+            .filter(|k| k.cmpge(LO).all() && k.cmple(HI).all())
+            .map(|k| k.to_array())
+            .collect()
+    }
+
+    /// Length of the part of the segment inside voxel `key` (exact slab test; 0 when it only
+    /// touches the voxel, `None` when it misses it).
+    fn overlap(start: DVec3, end: DVec3, key: IVec3) -> Option<f64> {
+        let d = end - start;
+        let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+        for a in 0..3 {
+            let (lo, hi) = (f64::from(key[a]), f64::from(key[a] + 1));
+            if d[a] == 0.0 {
+                if start[a] < lo || start[a] > hi {
+                    return None;
+                }
+            } else {
+                let (ta, tb) = ((lo - start[a]) / d[a], (hi - start[a]) / d[a]);
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            }
+        }
+        (t0 <= t1 + 1e-12).then(|| (t1 - t0).max(0.0) * d.length())
+    }
+
+    /// The walk agrees with brute-force sampling: every sampled voxel is visited (except one
+    /// the segment only touches, when a sample falls exactly on an edge or corner), and every
+    /// visited voxel the samples missed holds less than two sampling steps of the segment (0 for
+    /// the voxels a walk through an edge or corner adds); the path is 6-connected, has no
+    /// repeats, and runs from the first to the last sampled voxel.
+    fn check(start: DVec3, end: DVec3) {
+        let walk = keys(start, end);
+        let samples = sampled(start, end);
+        if samples.is_empty() {
+            // Misses the box, or touches it over less than a sampling step.
+            for k in &walk {
+                assert!(overlap(start, end, *k).is_some_and(|l| l < 2.0 * SAMPLE));
+            }
+            return;
+        }
+        let visited: BTreeSet<[i32; 3]> = walk.iter().map(|k| k.to_array()).collect();
+        assert_eq!(visited.len(), walk.len(), "repeat in {start} -> {end}");
+        for k in samples.difference(&visited) {
+            // A sample exactly on an edge or corner names a voxel the segment only touches.
+            let len = overlap(start, end, IVec3::from_array(*k));
+            assert!(
+                len.is_some_and(|l| l < 1e-9),
+                "missed {k:?} of {start} -> {end}: {len:?}"
+            );
+        }
+        for k in visited.difference(&samples) {
+            let len = overlap(start, end, IVec3::from_array(*k));
+            assert!(
+                len.is_some_and(|l| l < 2.0 * SAMPLE),
+                "{k:?} off the segment {start} -> {end}: {len:?}"
+            );
+        }
+        for pair in walk.windows(2) {
+            assert_eq!(
+                (pair[1] - pair[0]).abs().element_sum(),
+                1,
+                "not 6-connected"
+            );
+        }
+        // First and last voxels are those of the first and last samples.
+        let first = start.floor().as_ivec3();
+        if first.cmpge(LO).all() && first.cmple(HI).all() {
+            assert_eq!(walk[0], first);
+        }
+        let last = end.floor().as_ivec3();
+        if last.cmpge(LO).all() && last.cmple(HI).all() {
+            assert_eq!(*walk.last().unwrap(), last);
+        }
+    }
+
+    #[test]
+    fn random_rays_match_fine_sampling() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        let mut point = |r: f64| {
+            DVec3::new(
+                rng.random_range(-r..r),
+                rng.random_range(-r..r),
+                rng.random_range(-r..r),
+            )
+        };
+        for i in 0..400 {
+            // Short rays inside the box, long rays crossing its faces from outside.
+            let (start, end) = if i % 2 == 0 {
+                let s = point(18.0);
+                (s, s + point(4.0))
+            } else {
+                (point(26.0), point(26.0))
+            };
+            check(start, end);
+        }
+    }
+
+    #[test]
+    fn special_rays_match_fine_sampling() {
+        let v = DVec3::new;
+        let rays = [
+            // Along each axis, both directions, through voxel centres and along faces / edges.
+            (v(0.5, 0.5, 0.5), v(7.5, 0.5, 0.5)),
+            (v(0.5, -3.5, 0.5), v(0.5, -11.5, 0.5)),
+            (v(-4.5, 2.0, 2.0), v(-4.5, 2.0, 9.3)),
+            (v(-6.0, -6.0, 1.3), v(3.7, -6.0, 1.3)),
+            // Through voxel corners exactly (the diagonal), positive and negative.
+            (v(0.5, 0.5, 0.5), v(3.5, 3.5, 3.5)),
+            (v(-0.5, -0.5, -0.5), v(-5.5, -5.5, -5.5)),
+            (v(0.0, 0.0, 0.0), v(-4.0, 4.0, -4.0)),
+            // Through edges (two axes tie).
+            (v(0.5, 0.5, 0.25), v(4.5, 4.5, 0.75)),
+            // Starting (and ending) on a face.
+            (v(3.0, 0.5, 0.5), v(-2.0, 0.7, 0.1)),
+            (v(2.5, -1.0, 0.5), v(2.7, -4.0, 0.5)),
+            (v(1.2, 1.3, 1.4), v(5.0, 1.9, 1.1)),
+            // Negative coordinates across chunk-like borders, entering and leaving the box.
+            (v(-25.0, -19.5, -0.5), v(25.0, 19.25, 0.5)),
+            (v(-19.99, -19.99, -19.99), v(19.99, 19.99, 19.99)),
+            // Entirely outside, and grazing the box surface from outside.
+            (v(-30.0, 25.0, 0.0), v(30.0, 25.0, 0.0)),
+            (v(-30.0, 20.0, 0.0), v(30.0, 20.0, 0.0)),
+        ];
+        for (start, end) in rays {
+            check(start, end);
+        }
+        assert!(keys(v(-30.0, 25.0, 0.0), v(30.0, 25.0, 0.0)).is_empty());
+        assert!(keys(v(-30.0, 20.0, 0.0), v(30.0, 20.0, 0.0)).is_empty());
+        // Exact paths: along +x from voxel 0 to 7; the corner diagonal takes 9 steps, x then y
+        // then z at each corner.
+        assert_eq!(keys(v(0.5, 0.5, 0.5), v(7.5, 0.5, 0.5)).len(), 8);
+        let diagonal = keys(v(0.5, 0.5, 0.5), v(3.5, 3.5, 3.5));
+        assert_eq!(diagonal.len(), 10);
+        assert_eq!(
+            &diagonal[..4],
+            &[IVec3::ZERO, IVec3::X, IVec3::new(1, 1, 0), IVec3::ONE]
+        );
+    }
+
+    #[test]
+    fn zero_length_ray_visits_its_voxel() {
+        let p = DVec3::new(-3.25, 0.0, 7.9);
+        assert_eq!(keys(p, p), vec![IVec3::new(-4, 0, 7)]);
+        assert!(keys(DVec3::splat(20.0), DVec3::splat(20.0)).is_empty());
+        // On the lower face of the box the point is inside (voxel -20).
+        assert_eq!(keys(DVec3::splat(-20.0), DVec3::splat(-20.0)), vec![LO]);
+    }
+
+    #[test]
+    fn clipping_reports_cut_ends() {
+        let c = clip_segment(
+            DVec3::new(-30.5, 0.5, 0.5),
+            DVec3::new(0.5, 0.5, 0.5),
+            LO,
+            HI,
+        )
+        .unwrap();
+        assert_eq!(
+            (c.start_key, c.end_key, c.end_inside),
+            (IVec3::new(-20, 0, 0), IVec3::ZERO, true)
+        );
+        let c = clip_segment(
+            DVec3::new(0.5, 0.5, 0.5),
+            DVec3::new(0.5, 40.0, 0.5),
+            LO,
+            HI,
+        )
+        .unwrap();
+        assert_eq!((c.end_key, c.end_inside), (IVec3::new(0, 19, 0), false));
+        // An end exactly on the upper face lies outside (half-open box): the segment is cut.
+        let c = clip_segment(DVec3::splat(0.5), DVec3::new(0.5, 20.0, 0.5), LO, HI).unwrap();
+        assert_eq!((c.end_key, c.end_inside), (IVec3::new(0, 19, 0), false));
+    }
+}

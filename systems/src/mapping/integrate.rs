@@ -1,0 +1,235 @@
+//! Integration of one scan into the map (common.md §1), as a plain function over any chunk
+//! storage ([`ChunkAccess`]): the ECS system and the tests and benchmarks share it.
+//!
+//! - Pass 1: each ray that hit applies the hit to its end voxel and stamps it.
+//! - Pass 2: each ray walks from the origin to its end (3D DDA), clipped to the map, and applies
+//!   the miss to every voxel not yet stamped by this scan. A hit ray's end voxel is excluded; a
+//!   ray cut at max range, or leaving the map, marks its whole segment free including its last
+//!   voxel (OctoMap's maxrange semantics).
+//!
+//! Hence a voxel that is both an end point and crossed counts as occupied, and each voxel is
+//! updated at most once per scan, with no per-scan clearing, sorting or allocation.
+
+use super::dda::{VoxelWalk, clip_segment};
+use super::update::{UpdateRule, update_voxel};
+use glam::{DVec3, IVec3, Vec3};
+use uavex_components::map::{
+    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
+    StatSums, StatTables, VoxelChunk, local_index,
+};
+use uavex_components::sensor::Scan;
+
+/// How far past a surface a hit point is moved along its ray (voxel units), so that a hit
+/// exactly on a voxel face lands in the obstacle's voxel, not the free one in front of it.
+pub const HIT_NUDGE: f64 = 1e-3;
+
+/// Index step inside a chunk for a step along x, y, z (see `local_index`).
+const STRIDE: [isize; 3] = [1, CHUNK_EDGE as isize, (CHUNK_EDGE * CHUNK_EDGE) as isize];
+
+/// Mutable access to the map's chunks, by flat chunk index (see [`ChunkGrid::flat`]).
+pub trait ChunkAccess {
+    /// The chunk with flat index `flat` (at `coord`) and its statistics; a chunk of unknown
+    /// voxels with zero statistics is created if absent.
+    fn chunk_mut(&mut self, flat: usize, coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums);
+
+    /// Told once per visit of a chunk in which some voxel's log-odds changed.
+    fn mark_written(&mut self, flat: usize);
+}
+
+/// The rays of one scan, in the world frame (see [`Scan`]).
+#[derive(Debug, Clone, Copy)]
+pub struct ScanRays<'a> {
+    pub origin: Vec3,
+    pub endpoints: &'a [Vec3],
+    /// Whether ray `i` ended on a surface (else it was cut at max range).
+    pub hit: &'a [bool],
+}
+
+impl<'a> ScanRays<'a> {
+    pub fn of(scan: &'a Scan) -> Self {
+        Self {
+            origin: scan.origin,
+            endpoints: &scan.endpoints,
+            hit: &scan.hit,
+        }
+    }
+}
+
+/// What one integration did.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ScanReport {
+    pub rays: usize,
+    /// Voxels visited: end voxels of hits inside the map plus every voxel the walks visited
+    /// (the traversal's work, counting voxels skipped because already updated by this scan).
+    pub voxel_visits: u64,
+    /// Voxels whose log-odds changed.
+    pub changed_voxels: u64,
+}
+
+/// A scan that cannot be integrated (refused before anything is written).
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ScanError {
+    #[error("scan has {endpoints} endpoints but {hits} hit flags")]
+    LengthMismatch { endpoints: usize, hits: usize },
+    #[error("scan origin is not finite: {0}")]
+    NonFiniteOrigin(Vec3),
+    #[error("scan endpoint {index} is not finite: {point}")]
+    NonFiniteEndpoint { index: usize, point: Vec3 },
+}
+
+/// Integrates one scan (common.md §1): see the module documentation. `totals` receives the
+/// change of every chunk's statistics (the map-wide [`uavex_components::map::MapTotals`]).
+pub fn integrate_scan(
+    config: &MapConfig,
+    scan: ScanId,
+    rays: ScanRays<'_>,
+    increments: LogOddsIncrements,
+    chunks: &mut impl ChunkAccess,
+    totals: &mut StatSums,
+) -> Result<ScanReport, ScanError> {
+    validate(&rays)?;
+    let rule = |delta: i16| UpdateRule {
+        stamp: scan.stamp(),
+        delta: i32::from(delta),
+        min: i32::from(config.clamp_min()),
+        max: i32::from(config.clamp_max()),
+    };
+    let mut run = Integration {
+        grid: config.chunk_grid(),
+        tables: config.tables(),
+        scan,
+        chunks,
+        totals,
+        report: ScanReport {
+            rays: rays.endpoints.len(),
+            ..ScanReport::default()
+        },
+    };
+    let origin = config.to_voxel_units(rays.origin);
+    let ends = || {
+        rays.endpoints
+            .iter()
+            .zip(rays.hit)
+            .map(|(&p, &hit)| (end_point(origin, config.to_voxel_units(p), hit), hit))
+    };
+
+    // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
+    let hit_rule = rule(increments.hit);
+    for (end, _) in ends().filter(|&(_, hit)| hit) {
+        let key = end.floor().as_ivec3();
+        if config.contains_key(key) {
+            run.update_one(key, hit_rule);
+        }
+    }
+
+    // Pass 2: free space along every ray, skipping voxels this scan already updated.
+    let miss_rule = rule(increments.miss);
+    for (end, hit) in ends() {
+        let Some(clip) = clip_segment(origin, end, config.key_min(), config.key_max()) else {
+            continue;
+        };
+        let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
+        let exclude_end = hit && clip.end_inside;
+        let visits = walk.steps_left() + 1 - u64::from(exclude_end);
+        run.update_walk(walk, visits, miss_rule);
+    }
+    Ok(run.report)
+}
+
+/// Where a ray's end voxel is looked up: a hit point is nudged [`HIT_NUDGE`] along the ray.
+#[inline]
+fn end_point(origin: DVec3, end: DVec3, hit: bool) -> DVec3 {
+    let d = end - origin;
+    let length = d.length();
+    if hit && length > 0.0 {
+        end + d * (HIT_NUDGE / length)
+    } else {
+        end
+    }
+}
+
+fn validate(rays: &ScanRays<'_>) -> Result<(), ScanError> {
+    if rays.endpoints.len() != rays.hit.len() {
+        return Err(ScanError::LengthMismatch {
+            endpoints: rays.endpoints.len(),
+            hits: rays.hit.len(),
+        });
+    }
+    if !rays.origin.is_finite() {
+        return Err(ScanError::NonFiniteOrigin(rays.origin));
+    }
+    match rays.endpoints.iter().position(|p| !p.is_finite()) {
+        Some(index) => Err(ScanError::NonFiniteEndpoint {
+            index,
+            point: rays.endpoints[index],
+        }),
+        None => Ok(()),
+    }
+}
+
+/// The state of one scan's integration.
+struct Integration<'a, C> {
+    grid: ChunkGrid,
+    tables: &'a StatTables,
+    scan: ScanId,
+    chunks: &'a mut C,
+    totals: &'a mut StatSums,
+    report: ScanReport,
+}
+
+impl<C: ChunkAccess> Integration<'_, C> {
+    /// Updates the single voxel `key` (inside the map).
+    fn update_one(&mut self, key: IVec3, rule: UpdateRule) {
+        let coord = ChunkCoord::of_key(key);
+        let flat = self.grid.flat_unchecked(coord);
+        let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
+        chunk.begin_scan(self.scan);
+        let before = *stats;
+        let voxel = &mut chunk.voxels_mut()[local_index(key) & (CHUNK_VOXELS - 1)];
+        let changed = update_voxel(voxel, rule, self.tables, stats);
+        self.totals.add_change(&before, stats);
+        self.report.voxel_visits += 1;
+        if changed {
+            self.report.changed_voxels += 1;
+            self.chunks.mark_written(flat);
+        }
+    }
+
+    /// Updates the first `visits` voxels of `walk` (all inside the map). The inner loop runs
+    /// while the walk stays inside one chunk: integer index stepping, no lookups, no bounds
+    /// checks (the index is masked to the chunk, which it never leaves anyway).
+    fn update_walk(&mut self, mut walk: VoxelWalk, mut visits: u64, rule: UpdateRule) {
+        self.report.voxel_visits += visits;
+        while visits > 0 {
+            let key = walk.key();
+            let coord = ChunkCoord::of_key(key);
+            let flat = self.grid.flat_unchecked(coord);
+            let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
+            chunk.begin_scan(self.scan);
+            let before = *stats;
+            let voxels = chunk.voxels_mut();
+            let mut local = key.rem_euclid(IVec3::splat(CHUNK_EDGE)).to_array();
+            let mut index = local_index(key);
+            let mut changed = 0u64;
+            loop {
+                let voxel = &mut voxels[index & (CHUNK_VOXELS - 1)];
+                changed += u64::from(update_voxel(voxel, rule, self.tables, stats));
+                visits -= 1;
+                if visits == 0 {
+                    break;
+                }
+                let (axis, step) = walk.step();
+                local[axis] += step;
+                if !(0..CHUNK_EDGE).contains(&local[axis]) {
+                    break;
+                }
+                index = index.wrapping_add_signed(STRIDE[axis] * step as isize);
+            }
+            self.totals.add_change(&before, stats);
+            if changed > 0 {
+                self.report.changed_voxels += changed;
+                self.chunks.mark_written(flat);
+            }
+        }
+    }
+}

@@ -1,0 +1,28 @@
+//! Map stage: integrates range scans into the occupancy map (common.md §1) and keeps the map
+//! statistics of common.md §5 up to date.
+//!
+//! - [`dda`]: Amanatides & Woo voxel traversal, clipped to the map.
+//! - [`update`]: the log-odds update of one voxel (stamp, add, clamp, statistics).
+//! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
+//! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
+//! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
+//! - [`system`]: the ECS system [`integrate_scans`] and [`insert_map_resources`].
+//!
+//! Wiring: insert the resources with [`insert_map_resources`] (plus `RunEnd`), and add
+//! [`integrate_scans`] to the Map set after sensing. Chunks it creates are spawned through
+//! Commands: systems that read the map later in the same tick must run after a command flush.
+
+pub mod dda;
+pub mod integrate;
+pub mod read;
+pub mod store;
+pub mod system;
+pub mod update;
+
+pub use integrate::{ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan};
+pub use read::{MapReader, OccupancyMap, map_accuracy};
+pub use store::ChunkStore;
+pub use system::{MappingScratch, insert_map_resources, integrate_scans};
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,91 @@
+//! A map held outside the ECS: the chunks in a dense table over the chunk grid. Used by tests,
+//! benchmarks and offline tools; the running engine keeps chunks as entities instead.
+
+use super::integrate::ChunkAccess;
+use super::read::OccupancyMap;
+use uavex_components::map::{ChunkCoord, ChunkGrid, MapConfig, StatSums, VoxelChunk};
+
+/// Chunks with their statistics, by flat chunk index, plus which chunks were written since
+/// [`ChunkStore::take_written`] was last called.
+#[derive(Debug, Clone)]
+pub struct ChunkStore {
+    config: MapConfig,
+    chunks: Vec<Option<(VoxelChunk, StatSums)>>,
+    written_flags: Vec<bool>,
+    written: Vec<usize>,
+}
+
+impl ChunkStore {
+    pub fn new(config: &MapConfig) -> Self {
+        let n = config.chunk_grid().len();
+        Self {
+            config: config.clone(),
+            chunks: vec![None; n],
+            written_flags: vec![false; n],
+            written: Vec::new(),
+        }
+    }
+
+    fn grid(&self) -> ChunkGrid {
+        self.config.chunk_grid()
+    }
+
+    /// Number of chunks created.
+    pub fn chunk_count(&self) -> usize {
+        self.chunks.iter().filter(|c| c.is_some()).count()
+    }
+
+    /// The incrementally kept statistics of the chunk at `coord`.
+    pub fn stats(&self, coord: ChunkCoord) -> Option<&StatSums> {
+        let flat = self.grid().flat(coord)?;
+        self.chunks[flat].as_ref().map(|(_, stats)| stats)
+    }
+
+    /// Chunks written since the last call, in the order first written; clears the record.
+    pub fn take_written(&mut self) -> Vec<ChunkCoord> {
+        let grid = self.grid();
+        for &flat in &self.written {
+            self.written_flags[flat] = false;
+        }
+        self.written
+            .drain(..)
+            .map(|flat| grid.coord(flat))
+            .collect()
+    }
+}
+
+impl ChunkAccess for ChunkStore {
+    #[inline]
+    fn chunk_mut(&mut self, flat: usize, _coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums) {
+        let (chunk, stats) =
+            self.chunks[flat].get_or_insert_with(|| (VoxelChunk::new(), StatSums::default()));
+        (chunk, stats)
+    }
+
+    #[inline]
+    fn mark_written(&mut self, flat: usize) {
+        if !self.written_flags[flat] {
+            self.written_flags[flat] = true;
+            self.written.push(flat);
+        }
+    }
+}
+
+impl OccupancyMap for ChunkStore {
+    fn config(&self) -> &MapConfig {
+        &self.config
+    }
+
+    fn chunk(&self, coord: ChunkCoord) -> Option<&VoxelChunk> {
+        let flat = self.grid().flat(coord)?;
+        self.chunks[flat].as_ref().map(|(chunk, _)| chunk)
+    }
+
+    fn chunks(&self) -> impl Iterator<Item = (ChunkCoord, &VoxelChunk)> {
+        let grid = self.grid();
+        self.chunks
+            .iter()
+            .enumerate()
+            .filter_map(move |(flat, c)| c.as_ref().map(|(chunk, _)| (grid.coord(flat), chunk)))
+    }
+}

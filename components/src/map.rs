@@ -23,7 +23,7 @@ pub use chunk::{
 };
 pub use config::{
     ChunkGrid, LogOddsIncrements, MAX_BOX_VOXELS, MapConfig, MapConfigError, MapSettings,
-    log_odds_to_milli, milli_to_log_odds,
+    floor_to_key, log_odds_to_milli, milli_to_log_odds,
 };
 pub use index::{ChunkIndex, ScanCounter};
 pub use stats::{ChunkStats, MapMetrics, MapTotals, STAT_ONE, StatEntry, StatSums, StatTables};

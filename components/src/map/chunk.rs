@@ -4,7 +4,11 @@ use bevy_ecs::prelude::*;
 use glam::IVec3;
 
 /// Voxels along each edge of a chunk.
-pub const CHUNK_EDGE: i32 = 16;
+pub const CHUNK_EDGE: i32 = 1 << CHUNK_SHIFT;
+/// log2 of [`CHUNK_EDGE`]: chunk addressing is an arithmetic shift (which rounds towards -inf,
+/// i.e. `div_euclid(16)`) and a mask (`rem_euclid(16)`), without branches.
+const CHUNK_SHIFT: i32 = 4;
+const CHUNK_MASK: i32 = CHUNK_EDGE - 1;
 /// Voxels in one chunk (16^3).
 pub const CHUNK_VOXELS: usize = 4096;
 
@@ -20,7 +24,7 @@ impl ChunkCoord {
     /// The chunk holding voxel `key` (negative keys round towards -inf: key -1 is in chunk -1).
     #[inline]
     pub fn of_key(key: IVec3) -> Self {
-        Self(key.div_euclid(IVec3::splat(CHUNK_EDGE)))
+        Self(key >> CHUNK_SHIFT)
     }
 
     /// Key of the chunk's voxel with local coordinates (0, 0, 0).
@@ -33,8 +37,8 @@ impl ChunkCoord {
 /// Index of voxel `key` inside its chunk: `x + 16 (y + 16 z)` of `key.rem_euclid(16)`.
 #[inline]
 pub fn local_index(key: IVec3) -> usize {
-    let l = key.rem_euclid(IVec3::splat(CHUNK_EDGE));
-    (l.x + CHUNK_EDGE * (l.y + CHUNK_EDGE * l.z)) as usize
+    let l = key & CHUNK_MASK;
+    (l.x | (l.y << CHUNK_SHIFT) | (l.z << (2 * CHUNK_SHIFT))) as usize
 }
 
 /// Key of the voxel at local index `index` (0..4096) of chunk `coord`; inverse of
@@ -236,6 +240,17 @@ mod tests {
             IVec3::new(0, 0, 1)
         );
         assert_eq!(local_index(IVec3::new(3, 2, 17)), 3 + 16 * (2 + 16));
+    }
+
+    #[test]
+    fn shifts_agree_with_euclidean_division() {
+        for k in -100..100 {
+            let key = IVec3::new(k, -k, 3 * k);
+            let edge = IVec3::splat(CHUNK_EDGE);
+            assert_eq!(ChunkCoord::of_key(key).0, key.div_euclid(edge));
+            let l = key.rem_euclid(edge);
+            assert_eq!(local_index(key), (l.x + 16 * (l.y + 16 * l.z)) as usize);
+        }
     }
 
     #[test]

@@ -247,7 +247,7 @@ impl MapConfig {
     /// Key of the voxel holding `point` (may lie outside the map; saturates for huge points).
     #[inline]
     pub fn raw_key_of(&self, point: Vec3) -> IVec3 {
-        self.to_voxel_units(point).floor().as_ivec3()
+        floor_to_key(self.to_voxel_units(point))
     }
 
     /// Key of the voxel holding `point`, or `None` outside the map.
@@ -312,6 +312,18 @@ impl MapConfig {
             miss: check("miss", quality.log_odds_miss, "< 0", false)?,
         })
     }
+}
+
+/// `floor(q)` as a key, saturating at the i32 range (NaN gives 0), exactly as
+/// `q.floor().as_ivec3()`. Written as truncation plus a correction because `f64::floor` is a
+/// library call on the baseline x86-64 target (no SSE4.1), and keys are computed per ray.
+#[inline]
+pub fn floor_to_key(q: DVec3) -> IVec3 {
+    let floor = |x: f64| {
+        let t = x as i32;
+        t.saturating_sub(i32::from(f64::from(t) > x))
+    };
+    IVec3::new(floor(q.x), floor(q.y), floor(q.z))
 }
 
 /// Milli-log-odds of a log-odds value, rounded to nearest (saturating for huge values).
@@ -398,6 +410,34 @@ mod tests {
         assert_eq!(c.chunk_grid().min, IVec3::splat(-2));
         assert_eq!(c.chunk_grid().coord(flat).0, IVec3::new(-1, -2, -2));
         assert_eq!(local, 15 + 16 * (12 + 16 * 12));
+    }
+
+    #[test]
+    fn fast_floor_equals_floor() {
+        let xs = [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.9999999999999996,
+            -2.9999999999999996,
+            1e-300,
+            -1e-300,
+            2147483647.5,
+            -2147483648.0,
+            -2147483648.5,
+            3e9,
+            -3e9,
+            f64::NAN,
+            f64::INFINITY,
+            f64::NEG_INFINITY,
+        ];
+        for x in xs {
+            let q = DVec3::new(x, -x, x * 0.5);
+            assert_eq!(floor_to_key(q), q.floor().as_ivec3(), "{x}");
+        }
     }
 
     #[test]

@@ -16,8 +16,12 @@ use super::source_map::Anchor;
 use super::suggest::{closest, list, plain_list};
 use super::tree::{Element, Entry, Node, Value};
 
-/// A unit cannot take more rounds than it has values; this only bounds the loop for certain.
-const MAX_ROUNDS: usize = 10_000;
+/// Problems reported per unit (an entry); past this, the entry is only said to have more. Each
+/// problem costs a few decodings of its entry, so this also bounds the time a hostile file
+/// can take.
+const MAX_FINDINGS_PER_UNIT: usize = 50;
+/// Trial decodings spent locating one problem (see `blame`).
+const MAX_BLAME_TRIALS: usize = 256;
 
 /// The decoded pieces of a file, with their indices in the file; `None` where a piece had
 /// problems (already reported).
@@ -140,13 +144,25 @@ fn decode_unit<T: DeserializeOwned>(
     findings: &mut Vec<Finding>,
 ) -> Option<T> {
     let mut removed: Vec<FieldPath> = Vec::new();
-    let mut clean = true;
-    for _ in 0..MAX_ROUNDS {
+    let first = findings.len();
+    loop {
         let error = match try_decode::<T>(&node, root) {
-            Ok(value) => return clean.then_some(value),
+            Ok(value) => return (findings.len() == first).then_some(value),
             Err(error) => error,
         };
-        clean = false;
+        if findings.len() - first >= MAX_FINDINGS_PER_UNIT {
+            findings.push(
+                Finding::new(
+                    root.clone(),
+                    Anchor::Key,
+                    format!(
+                        "more problems in this entry are not shown (the first {MAX_FINDINGS_PER_UNIT} are)"
+                    ),
+                )
+                .expected("an entry with fewer problems"),
+            );
+            return None;
+        }
         let at = error.path.clone().unwrap_or_else(|| root.clone());
         let cut = if let DeErrorKind::MissingField { field } = &error.kind {
             // A value we cut out earlier is not missing a second time.
@@ -167,7 +183,6 @@ fn decode_unit<T: DeserializeOwned>(
         }
         removed.push(cut);
     }
-    None
 }
 
 /// Narrows an error down to the value it is about. Errors from serde's buffered content
@@ -230,10 +245,14 @@ fn find_unknown_key(
     best.map(|(_, _, path)| path)
 }
 
-/// The value inside `target` whose removal changes the error: serde decodes a table's values in
-/// order and stops at the first bad one, so removing any other value leaves the error as it
-/// is. Children are tried before their parents (the innermost culprit wins); the `kind` tag is
-/// only blamed when it is not a string, since removing it always changes the error.
+/// The value inside `target` (found at `at`) the error is about. serde decodes a table's values
+/// in order and stops at the first bad one, so cutting out any other value leaves the same
+/// problem, while cutting out the value that holds the culprit makes it go away or become a
+/// different one. Starting at `at`, each level's values are tried in order and the search goes
+/// down into the first that matters, until no value below explains the error. The `kind` tag
+/// is only tried when it is not a string, since cutting it out always changes the error. The
+/// number of trial decodings is bounded, so a huge entry cannot make the loader hang; past the
+/// bound the error stays where it is.
 fn blame<T: DeserializeOwned>(
     node: &Node,
     root: &FieldPath,
@@ -241,26 +260,41 @@ fn blame<T: DeserializeOwned>(
     target: &Node,
     error: &DeError,
 ) -> FieldPath {
-    let tag = at.key("kind");
-    let mut candidates = target.descendants_post_order(at);
-    candidates.retain(|candidate| *candidate != tag);
-    if matches!(target.get(&[key("kind")]), Some(kind) if !matches!(kind.value, Value::String(_))) {
-        candidates.push(tag);
-    }
-    for candidate in candidates {
-        let Some(relative) = candidate.strip_prefix(root) else {
-            continue;
-        };
-        let mut trial = node.clone();
-        if !trial.remove(relative) {
-            continue;
+    let mut current = at.clone();
+    let mut level = target;
+    let mut trials = 0;
+    'descend: loop {
+        let mut candidates = level.children(&current);
+        let tag = current.key("kind");
+        if let Some(position) = candidates.iter().position(|(path, _)| *path == tag) {
+            let (path, kind) = candidates.remove(position);
+            if !matches!(kind.value, Value::String(_)) {
+                candidates.push((path, kind));
+            }
         }
-        match try_decode::<T>(&trial, root) {
-            Err(again) if same_problem(&again, error) => {}
-            _ => return candidate,
+        for (candidate, child) in candidates {
+            trials += 1;
+            if trials > MAX_BLAME_TRIALS {
+                return current;
+            }
+            let Some(relative) = candidate.strip_prefix(root) else {
+                continue;
+            };
+            let mut trial = node.clone();
+            if !trial.remove(relative) {
+                continue;
+            }
+            match try_decode::<T>(&trial, root) {
+                Err(again) if same_problem(&again, error) => {}
+                _ => {
+                    current = candidate;
+                    level = child;
+                    continue 'descend;
+                }
+            }
         }
+        return current;
     }
-    at.clone()
 }
 
 /// Whether two errors are the same problem: same place, kind and expectation. What was found

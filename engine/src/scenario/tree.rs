@@ -186,21 +186,6 @@ impl Node {
         }
     }
 
-    /// Paths (below `at`, which names this node) of every value inside this node, children
-    /// before their parents, in file order.
-    pub fn descendants_post_order(&self, at: &FieldPath) -> Vec<FieldPath> {
-        let mut out = Vec::new();
-        self.collect_post_order(at, &mut out);
-        out
-    }
-
-    fn collect_post_order(&self, at: &FieldPath, out: &mut Vec<FieldPath>) {
-        for (child_path, child) in self.children(at) {
-            child.collect_post_order(&child_path, out);
-            out.push(child_path);
-        }
-    }
-
     /// The direct children with their paths (`at` names this node).
     pub fn children(&self, at: &FieldPath) -> Vec<(FieldPath, &Node)> {
         match &self.value {
@@ -282,14 +267,15 @@ mod tests {
     }
 
     #[test]
-    fn post_order_lists_children_first() {
-        let tree = parse_document("t = { a = [1], b = 2 }\n").unwrap();
-        let paths: Vec<String> = tree
-            .descendants_post_order(&FieldPath::root())
+    fn children_come_in_file_order_with_their_paths() {
+        let tree = parse_document("t = { b = [1], a = 2 }\n").unwrap();
+        let t = tree.get(FieldPath::parse("t").segments()).unwrap();
+        let paths: Vec<String> = t
+            .children(&FieldPath::parse("t"))
             .iter()
-            .map(ToString::to_string)
+            .map(|(path, _)| path.to_string())
             .collect();
-        assert_eq!(paths, ["t.a[0]", "t.a", "t.b", "t"]);
+        assert_eq!(paths, ["t.b", "t.a"]);
     }
 
     #[test]

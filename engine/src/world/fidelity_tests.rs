@@ -6,7 +6,6 @@
 use super::build_world;
 use crate::scenario::WorldSpec;
 use glam::{DVec3, IVec3, Quat, Vec3};
-use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeMap;
 use std::path::Path;
 use uavex_components::map::{MapConfig, MapSettings, ScanId, VoxelState};
@@ -112,7 +111,7 @@ fn map_of_frames(
             origin: Vec3::from_array(position),
             rotation: Quat::from_rotation_z(yaw),
         };
-        sweep::<ChaCha8Rng>(pattern, pose, world, None, &mut scratch, &mut scan, 0.0);
+        sweep(pattern, pose, world, None, &mut scratch, &mut scan, 0.0);
         let scan_id = ScanId::after(id);
         id = Some(scan_id);
         integrate_scan(

@@ -10,6 +10,7 @@
 //! voxels beside it too, which is conservative for free space).
 
 use glam::{DVec3, IVec3};
+use uavex_components::map::floor_to_key;
 
 /// Stand-in for "never" in the boundary times of retired axes.
 const NEVER: f64 = f64::INFINITY;
@@ -46,14 +47,14 @@ pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<Cl
             t1 = t1.min(ta.max(tb));
         }
     }
-    let (raw_start, raw_end) = (start.floor().as_ivec3(), end.floor().as_ivec3());
+    let (raw_start, raw_end) = (floor_to_key(start), floor_to_key(end));
     let (start_inside, end_inside) = (inside(raw_start), inside(raw_end));
     if t0 > t1 || (t0 == t1 && !start_inside && !end_inside) {
         return None;
     }
     // Points on the segment keep their key when inside (the same `floor` every key
     // computation uses); entry and exit points are clamped into the box against rounding.
-    let key_at = |t: f64| (start + d * t).floor().as_ivec3().clamp(lo, hi);
+    let key_at = |t: f64| floor_to_key(start + d * t).clamp(lo, hi);
     Some(ClippedSegment {
         start_key: if start_inside { raw_start } else { key_at(t0) },
         end_key: if end_inside { raw_end } else { key_at(t1) },
@@ -64,7 +65,9 @@ pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<Cl
 /// The state of a traversal from `start_key` to `end_key` along the segment `start -> end`.
 #[derive(Debug, Clone, Copy)]
 pub struct VoxelWalk {
-    key: IVec3,
+    /// The current key (an array, not an `IVec3`: indexing an `IVec3` by a run-time axis is a
+    /// `match`, i.e. a mispredicted branch per step).
+    key: [i32; 3],
     /// Segment parameter at which the next boundary on each axis is crossed.
     t_max: [f64; 3],
     /// Parameter increment between boundaries on each axis (1 / |d|).
@@ -79,7 +82,7 @@ impl VoxelWalk {
     pub fn new(start: DVec3, end: DVec3, start_key: IVec3, end_key: IVec3) -> Self {
         let d = end - start;
         let mut walk = Self {
-            key: start_key,
+            key: start_key.to_array(),
             t_max: [NEVER; 3],
             t_delta: [NEVER; 3],
             step: [0; 3],
@@ -102,7 +105,7 @@ impl VoxelWalk {
     /// The current key.
     #[inline]
     pub fn key(&self) -> IVec3 {
-        self.key
+        IVec3::from_array(self.key)
     }
 
     /// Steps left until the end key.
@@ -112,21 +115,23 @@ impl VoxelWalk {
 
     /// Moves to the next voxel; returns the axis moved along and the step (+1 or -1).
     /// Only meaningful while [`Self::steps_left`] > 0.
+    ///
+    /// The axis is the one with the earliest boundary (ties go to x, then y, then z), chosen
+    /// with selects rather than branches: which axis comes next is as good as random, so a
+    /// branch would be mispredicted about every other step.
     #[inline(always)]
     pub fn step(&mut self) -> (usize, i32) {
-        let t = &self.t_max;
-        let axis = if t[0] <= t[1] {
-            if t[0] <= t[2] { 0 } else { 2 }
-        } else if t[1] <= t[2] {
-            1
-        } else {
+        let t = self.t_max;
+        let first_of_xy = usize::from(t[1] < t[0]);
+        let axis = if t[2] < t[0].min(t[1]) {
             2
+        } else {
+            first_of_xy
         };
-        self.t_max[axis] += self.t_delta[axis];
-        self.remaining[axis] = self.remaining[axis].saturating_sub(1);
-        if self.remaining[axis] == 0 {
-            self.t_max[axis] = NEVER;
-        }
+        let remaining = self.remaining[axis].saturating_sub(1);
+        self.remaining[axis] = remaining;
+        let next = t[axis] + self.t_delta[axis];
+        self.t_max[axis] = if remaining == 0 { NEVER } else { next };
         let step = self.step[axis];
         self.key[axis] += step;
         (axis, step)

@@ -15,7 +15,7 @@ use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
 use uavex_components::map::{
     CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
-    StatSums, StatTables, VoxelChunk, local_index,
+    StatSums, StatTables, VoxelChunk, floor_to_key, local_index,
 };
 use uavex_components::sensor::Scan;
 
@@ -116,7 +116,7 @@ pub fn integrate_scan(
     // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
     let hit_rule = rule(increments.hit);
     for (end, _) in ends().filter(|&(_, hit)| hit) {
-        let key = end.floor().as_ivec3();
+        let key = floor_to_key(end);
         if config.contains_key(key) {
             run.update_one(key, hit_rule);
         }
@@ -208,7 +208,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             chunk.begin_scan(self.scan);
             let before = *stats;
             let voxels = chunk.voxels_mut();
-            let mut local = key.rem_euclid(IVec3::splat(CHUNK_EDGE)).to_array();
+            let mut local = (key & (CHUNK_EDGE - 1)).to_array();
             let mut index = local_index(key);
             let mut changed = 0u64;
             loop {
@@ -220,7 +220,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 }
                 let (axis, step) = walk.step();
                 local[axis] += step;
-                if !(0..CHUNK_EDGE).contains(&local[axis]) {
+                if local[axis] as u32 >= CHUNK_EDGE as u32 {
                     break;
                 }
                 index = index.wrapping_add_signed(STRIDE[axis] * step as isize);

@@ -7,6 +7,7 @@ use bevy_ecs::prelude::*;
 use glam::{DVec3, IVec3};
 use uavex_components::map::{
     ChunkCoord, ChunkIndex, ChunkStats, MapConfig, MapTotals, ScanCounter, StatSums, VoxelChunk,
+    floor_to_key,
 };
 use uavex_components::sensor::{Scan, SensorId, SensorQuality};
 use uavex_components::sim::{Outcome, RunEnd};
@@ -140,8 +141,8 @@ fn chunk_box(config: &MapConfig, scan: &Scan) -> Option<(IVec3, IVec3)> {
             (lo.min(q), hi.max(q))
         });
     let margin = DVec3::splat(2.0 * HIT_NUDGE);
-    let klo = (lo - margin).floor().as_ivec3().max(config.key_min());
-    let khi = (hi + margin).floor().as_ivec3().min(config.key_max());
+    let klo = floor_to_key(lo - margin).max(config.key_min());
+    let khi = floor_to_key(hi + margin).min(config.key_max());
     if klo.cmpgt(khi).any() {
         return None;
     }

@@ -4,7 +4,6 @@
 use super::RayPattern;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
-use rand::Rng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use uavex_components::sensor::{Mount, Scan};
@@ -80,10 +79,10 @@ pub struct SweepScratch {
     distances: Vec<Option<f32>>,
 }
 
-/// Gaussian range noise: standard deviation (m) and the stream to draw from.
-pub struct RangeNoise<'a, R: Rng> {
+/// Gaussian range noise: standard deviation (m) and the sensor's stream to draw from.
+pub struct RangeNoise<'a> {
     pub std_m: f32,
-    pub rng: &'a mut R,
+    pub rng: &'a mut ChaCha8Rng,
 }
 
 /// Casts the pattern's rays from `pose` into `world` and fills `scan` in place
@@ -96,11 +95,11 @@ pub struct RangeNoise<'a, R: Rng> {
 ///
 /// With noise, rays are cast `4 std` beyond `range_max`, so that a surface just out of range may
 /// be measured inside it, as a real sensor would.
-pub fn sweep<R: Rng>(
+pub fn sweep(
     pattern: &RayPattern,
     pose: SensorPose,
     world: &WorldGeometry,
-    mut noise: Option<RangeNoise<'_, R>>,
+    mut noise: Option<RangeNoise<'_>>,
     scratch: &mut SweepScratch,
     scan: &mut Scan,
     time_s: f64,

@@ -268,7 +268,7 @@ fn mounted_sensor_pose_follows_uav_and_mount() {
     )
     .unwrap();
     let mut scan = Scan::default();
-    sweep::<ChaCha8Rng>(
+    sweep(
         &pattern,
         pose,
         &world,
@@ -314,7 +314,7 @@ fn sweep_drops_close_rays_cuts_far_rays_and_reuses_buffers() {
     };
     let mut scratch = SweepScratch::default();
     let mut scan = Scan::default();
-    sweep::<ChaCha8Rng>(&pattern, pose, &world, None, &mut scratch, &mut scan, 0.0);
+    sweep(&pattern, pose, &world, None, &mut scratch, &mut scan, 0.0);
     // Beam 0 (right): no surface, cut at 10 m. Beam 1 (ahead): 4 m. Beam 2 (left): 0.6 m.
     assert_eq!(scan.hit, vec![false, true, true]);
     let right = Vec3::new(30f32.to_radians().cos(), -0.5, 0.0);
@@ -327,7 +327,7 @@ fn sweep_drops_close_rays_cuts_far_rays_and_reuses_buffers() {
     pattern.range_max = 3.0;
     let capacity = scan.endpoints.capacity();
     let buffer = scan.endpoints.as_ptr();
-    sweep::<ChaCha8Rng>(&pattern, pose, &world, None, &mut scratch, &mut scan, 0.1);
+    sweep(&pattern, pose, &world, None, &mut scratch, &mut scan, 0.1);
     assert_eq!(scan.hit, vec![false, false]);
     assert!((scan.endpoints[1] - Vec3::new(3.0, 0.0, 0.0)).length() < 1e-5);
     assert_eq!(scan.sequence, 2);

@@ -210,3 +210,6 @@ fn inside(point: [f64; 3], min: [f64; 3], max: [f64; 3]) -> bool {
 fn triple(v: [f64; 3]) -> String {
     format!("[{}, {}, {}]", number(v[0]), number(v[1]), number(v[2]))
 }
+
+#[cfg(test)]
+mod tests;

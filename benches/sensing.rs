@@ -1,0 +1,169 @@
+//! Sensing cost (common.md §2) in the EAAE Pillars scene (`scenarios/eaae_pillars.toml`).
+//!
+//! - `raycast`: rays per second against the scene's parry BVH (ground, four walls, three
+//!   pillars): the thesis camera's 307,200 per-pixel rays from in front of pillar 1, cast one by
+//!   one and as one batch (parallel above `PARALLEL_RAY_THRESHOLD`), and a 270 deg planar lidar
+//!   (1,080 beams, 20 m).
+//! - `sense_and_map`: one thesis-camera frame swept and integrated into a warmed-up 0.1 m map
+//!   (all chunks exist, the steady state of a run), with the auto grid (55 x 41 = 2,255 rays)
+//!   and with one ray per pixel (307,200 rays).
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use glam::{DVec3, Quat, Vec3};
+use std::hint::black_box;
+use uavex_components::map::{MapConfig, MapSettings, ScanId, StatSums};
+use uavex_components::sensor::{Scan, SensorQuality};
+use uavex_components::sim::RunSeed;
+use uavex_components::world::WorldGeometry;
+use uavex_engine::scenario;
+use uavex_engine::world::build_world;
+use uavex_systems::mapping::{ChunkStore, ScanRays, integrate_scan};
+use uavex_systems::sensing::{
+    LidarBeams, PinholeCamera, RayGrid, RayPattern, SensorPose, SweepScratch, camera_pattern,
+    lidar_pattern, sweep,
+};
+
+const THESIS_CAMERA: PinholeCamera = PinholeCamera {
+    width: 640,
+    height: 480,
+    hfov: 1.0,
+};
+
+/// 2.5 m in front of pillar 1's north face, looking at it (-y): the pillar fills the middle of
+/// the image, the floor its bottom, the south wall (beyond range) its sides.
+fn facing_pillar() -> SensorPose {
+    SensorPose {
+        origin: Vec3::new(0.0, -2.9, 1.2),
+        rotation: Quat::from_rotation_z(-std::f32::consts::FRAC_PI_2),
+    }
+}
+
+fn pillars() -> (WorldGeometry, MapConfig) {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/eaae_pillars.toml");
+    let loaded = scenario::load(path).expect("the shipped Pillars scenario loads");
+    let world_spec = &loaded.scenario.world;
+    let start = Vec3::new(0.0, 0.0, 1.0);
+    let world = build_world(world_spec, RunSeed(1), &[start], &loaded.base_dir)
+        .expect("the Pillars world builds");
+    let map = MapConfig::new(&MapSettings {
+        resolution: loaded.scenario.map.resolution,
+        bounds_min: DVec3::from_array(world_spec.bounds.min),
+        bounds_max: DVec3::from_array(world_spec.bounds.max),
+        p_min: loaded.scenario.map.p_min,
+        p_max: loaded.scenario.map.p_max,
+    })
+    .expect("valid map");
+    (world, map)
+}
+
+fn per_pixel() -> RayPattern {
+    let grid = RayGrid::Explicit {
+        columns: 640,
+        rows: 480,
+    };
+    camera_pattern(THESIS_CAMERA, grid, 0.5, 5.0).unwrap()
+}
+
+fn raycast(c: &mut Criterion) {
+    let (world, _) = pillars();
+    let pose = facing_pillar();
+    let camera: Vec<Vec3> = per_pixel()
+        .directions
+        .iter()
+        .map(|d| pose.rotation * *d)
+        .collect();
+    let lidar = lidar_pattern(
+        LidarBeams {
+            hfov: 270f64.to_radians(),
+            beams_h: 1080,
+            vfov: 0.0,
+            beams_v: 1,
+        },
+        0.1,
+        20.0,
+    )
+    .unwrap();
+
+    let mut group = c.benchmark_group("raycast");
+    group.throughput(Throughput::Elements(camera.len() as u64));
+    group.bench_function("camera_per_pixel_one_by_one", |b| {
+        b.iter(|| {
+            let mut hits = 0u32;
+            for dir in &camera {
+                hits += u32::from(world.cast_ray(pose.origin, *dir, 5.0).is_some());
+            }
+            black_box(hits)
+        })
+    });
+    let mut distances = Vec::new();
+    group.bench_function("camera_per_pixel_batch", |b| {
+        b.iter(|| {
+            world.cast_rays(pose.origin, &camera, 5.0, &mut distances);
+            black_box(distances.len())
+        })
+    });
+    group.throughput(Throughput::Elements(lidar.directions.len() as u64));
+    group.bench_function("lidar_270deg_1080_beams_20m", |b| {
+        b.iter(|| {
+            world.cast_rays(
+                Vec3::new(0.0, 0.0, 1.0),
+                &lidar.directions,
+                20.0,
+                &mut distances,
+            );
+            black_box(distances.len())
+        })
+    });
+    group.finish();
+}
+
+fn sense_and_map(c: &mut Criterion) {
+    let (world, map) = pillars();
+    let increments = map
+        .increments(&SensorQuality::from_probabilities(0.7, 0.4, 0.0))
+        .unwrap();
+    let auto = camera_pattern(THESIS_CAMERA, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).unwrap();
+    let mut group = c.benchmark_group("sense_and_map");
+    for (name, pattern) in [("auto", auto), ("per_pixel", per_pixel())] {
+        let mut store = ChunkStore::new(&map);
+        let mut totals = StatSums::default();
+        let mut scan = Scan::default();
+        let mut scratch = SweepScratch::default();
+        let mut id = ScanId::after(None);
+        // Warm-up: the chunks this frame touches exist, buffers have their size.
+        sweep(
+            &pattern,
+            facing_pillar(),
+            &world,
+            None,
+            &mut scratch,
+            &mut scan,
+            0.0,
+        );
+        let rays = ScanRays::of(&scan);
+        integrate_scan(&map, id, rays, increments, &mut store, &mut totals).unwrap();
+        group.throughput(Throughput::Elements(pattern.directions.len() as u64));
+        group.bench_function(BenchmarkId::new("thesis_camera_frame", name), |b| {
+            b.iter(|| {
+                sweep(
+                    &pattern,
+                    facing_pillar(),
+                    &world,
+                    None,
+                    &mut scratch,
+                    &mut scan,
+                    0.0,
+                );
+                id = ScanId::after(Some(id));
+                let rays = ScanRays::of(&scan);
+                black_box(
+                    integrate_scan(&map, id, rays, increments, &mut store, &mut totals).unwrap(),
+                )
+            })
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, raycast, sense_and_map);
+criterion_main!(benches);

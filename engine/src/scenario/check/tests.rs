@@ -1,0 +1,382 @@
+//! The semantic checks on plain schema values (no file, no World).
+
+use super::*;
+
+/// A valid scenario; tests change one thing in it.
+const BASE: &str = r#"
+name = "t"
+time_limit_s = 60.0
+
+[world.bounds]
+min = [0.0, 0.0, 0.0]
+max = [10.0, 10.0, 3.0]
+
+[[uav]]
+name = "a"
+start = { position = [1.0, 1.0, 1.0] }
+
+[[uav.sensor]]
+kind = "depth_camera"
+
+[uav.behaviour]
+kind = "scripted"
+speed = 1.0
+waypoints = [[5.0, 5.0, 1.0]]
+"#;
+
+fn scenario(text: &str) -> Scenario {
+    toml::from_str(text).expect("test scenarios parse")
+}
+
+/// `(path, message, found)` of every finding of `text` (non-finite numbers included).
+fn findings(text: &str) -> Vec<(String, String, Option<String>)> {
+    let scenario = scenario(text);
+    let mut all = non_finite(&scenario);
+    all.extend(check_parts(&Parts::of(&scenario)));
+    all.into_iter()
+        .map(|f| (f.path.to_string(), f.message, f.found))
+        .collect()
+}
+
+/// `BASE` with `old` replaced by `new` (which must occur).
+fn with(old: &str, new: &str) -> String {
+    assert!(BASE.contains(old), "{old} is not in the base scenario");
+    BASE.replacen(old, new, 1)
+}
+
+fn one(text: &str) -> (String, String, Option<String>) {
+    let mut all = findings(text);
+    assert_eq!(all.len(), 1, "expected exactly one finding, got {all:#?}");
+    all.remove(0)
+}
+
+fn finding(path: &str, message: &str, found: &str) -> (String, String, Option<String>) {
+    (path.to_owned(), message.to_owned(), Some(found.to_owned()))
+}
+
+#[test]
+fn the_base_scenario_is_clean() {
+    assert_eq!(findings(BASE), vec![]);
+}
+
+#[test]
+fn run_settings() {
+    assert_eq!(
+        one(&with("time_limit_s = 60.0", "time_limit_s = 0.0")),
+        finding("time_limit_s", "must be above 0", "0.0")
+    );
+    assert_eq!(
+        one(&with("time_limit_s = 60.0", "time_limit_s = 60.0\nphysics_rate_hz = -300.0")),
+        finding("physics_rate_hz", "must be above 0", "-300.0")
+    );
+    // 1e6 s at 300 Hz is 3e8 steps; the limit 1e8 allows 333333.33 s.
+    let (path, message, _) = one(&with("time_limit_s = 60.0", "time_limit_s = 1e6"));
+    assert_eq!(path, "time_limit_s");
+    assert!(message.starts_with("must be at most 333333.33"), "{message}");
+    assert_eq!(
+        one(&with("time_limit_s = 60.0", "time_limit_s = 60.0\noutputs = { series_rate_hz = 0.0 }")),
+        finding("outputs.series_rate_hz", "must be above 0", "0.0")
+    );
+}
+
+#[test]
+fn map_probabilities() {
+    let map = |body: &str| with("[world.bounds]", &format!("[map]\n{body}\n[world.bounds]"));
+    assert_eq!(
+        one(&map("p_hit = 1.0")),
+        finding("map.p_hit", "must be a probability in (0, 1)", "1.0")
+    );
+    assert_eq!(
+        one(&map("p_hit = 0.5")),
+        finding("map.p_hit", "must be above 0.5 (a hit must raise the occupancy)", "0.5")
+    );
+    assert_eq!(
+        one(&map("p_miss = 0.5")),
+        finding("map.p_miss", "must be below 0.5 (a miss must lower the occupancy)", "0.5")
+    );
+    assert_eq!(
+        one(&map("p_min = 0.0")),
+        finding("map.p_min", "must be a probability in (0, 1)", "0.0")
+    );
+    assert_eq!(
+        one(&map("p_min = 0.9\np_max = 0.8")),
+        finding("map.p_min", "must be below p_max (0.8)", "0.9")
+    );
+    assert_eq!(
+        one(&map("p_min = 0.6")),
+        finding("map.p_min", "must be below 0.5 (else no voxel can ever be free)", "0.6")
+    );
+    assert_eq!(
+        one(&map("p_max = 0.4\np_min = 0.1")),
+        finding("map.p_max", "must be at least 0.5 (else no voxel can ever be occupied)", "0.4")
+    );
+}
+
+#[test]
+fn bounds_and_resolution() {
+    assert_eq!(
+        one(&with("max = [10.0, 10.0, 3.0]", "max = [10.0, 10.0, 0.0]")),
+        finding(
+            "world.bounds.max[2]",
+            "must be above world.bounds.min[2] (0.0): the bounds need a positive extent along z",
+            "0.0"
+        )
+    );
+    let all = findings(&with("max = [10.0, 10.0, 3.0]", "max = [-1.0, 10.0, -3.0]"));
+    let paths: Vec<&str> = all.iter().map(|(p, _, _)| p.as_str()).collect();
+    // Both bad axes; no resolution or start check against bounds that make no sense.
+    assert_eq!(paths, ["world.bounds.max[0]", "world.bounds.max[2]"]);
+
+    let map = |body: &str| with("[world.bounds]", &format!("[map]\n{body}\n[world.bounds]"));
+    assert_eq!(
+        one(&map("resolution = -0.1")),
+        finding("map.resolution", "must be above 0", "-0.1")
+    );
+    // Smallest side 3 m: at least 4 voxels along it means at most 0.75 m.
+    assert_eq!(
+        one(&map("resolution = 1.0")),
+        finding(
+            "map.resolution",
+            "must be at most 0.75 (at least 4 voxels along the smallest side of world.bounds, 3.0 m)",
+            "1.0"
+        )
+    );
+    // 10 x 10 x 3 m at 1 mm: 3e11 voxels; the finest allowed is cbrt(300 / 2e9) = 5.3 mm.
+    let (path, message, found) = one(&map("resolution = 0.001"));
+    assert_eq!(path, "map.resolution");
+    assert_eq!(
+        message,
+        "must be at least about 0.005 (world.bounds would hold 3.000e11 voxels; the limit is 2e9)"
+    );
+    assert_eq!(found.as_deref(), Some("0.001"));
+}
+
+#[test]
+fn camera_settings() {
+    let camera = |extra: &str| with("kind = \"depth_camera\"", &format!("kind = \"depth_camera\"\n{extra}"));
+    assert_eq!(
+        one(&camera("range_min = 6.0\nrange_max = 5.0")),
+        finding("uav[0].sensor[0].range_min", "must be below range_max (5.0)", "6.0")
+    );
+    assert_eq!(
+        one(&camera("range_min = -0.5")),
+        finding("uav[0].sensor[0].range_min", "must be at least 0", "-0.5")
+    );
+    assert_eq!(
+        one(&camera("range_max = -5.0")),
+        finding("uav[0].sensor[0].range_max", "must be above 0", "-5.0")
+    );
+    assert_eq!(
+        one(&camera("rate_hz = 0.0")),
+        finding("uav[0].sensor[0].rate_hz", "must be above 0", "0.0")
+    );
+    assert_eq!(
+        one(&camera("hfov = 3.2")),
+        finding("uav[0].sensor[0].hfov", "must be in (0, pi) rad", "3.2")
+    );
+    assert_eq!(
+        one(&camera("hfov = 0.0")),
+        finding("uav[0].sensor[0].hfov", "must be in (0, pi) rad", "0.0")
+    );
+    assert_eq!(
+        one(&camera("width = 0")),
+        finding("uav[0].sensor[0].width", "must be at least 1", "0")
+    );
+    assert_eq!(
+        one(&camera("ray_grid = [64, 0]")),
+        finding("uav[0].sensor[0].ray_grid[1]", "must be at least 1", "0")
+    );
+    let (path, _, found) = one(&camera("ray_grid = [10000, 10000]"));
+    assert_eq!(path, "uav[0].sensor[0].ray_grid");
+    assert_eq!(found.as_deref(), Some("1.000e8 rays"));
+    // Auto grid at 1 mm voxels and 50 m range: step 2e-5 rad, 50001 x 38962 rays.
+    let fine = with("[world.bounds]", "[map]\nresolution = 0.001\n[world.bounds]")
+        .replace("max = [10.0, 10.0, 3.0]", "max = [1.0, 1.0, 1.0]")
+        .replace("[1.0, 1.0, 1.0] }", "[0.5, 0.5, 0.5] }")
+        .replace("[[5.0, 5.0, 1.0]]", "[[0.5, 0.6, 0.5]]")
+        .replace("kind = \"depth_camera\"", "kind = \"depth_camera\"\nrange_max = 50.0");
+    let (path, _, found) = one(&fine);
+    assert_eq!(path, "uav[0].sensor[0].ray_grid");
+    assert_eq!(found.as_deref(), Some("1.948e9 rays"));
+}
+
+#[test]
+fn sensor_quality() {
+    let camera = |extra: &str| with("kind = \"depth_camera\"", &format!("kind = \"depth_camera\"\n{extra}"));
+    assert_eq!(
+        one(&camera("quality = { p_hit = 0.4 }")),
+        finding(
+            "uav[0].sensor[0].quality.p_hit",
+            "must be above 0.5 (a hit must raise the occupancy)",
+            "0.4"
+        )
+    );
+    assert_eq!(
+        one(&camera("quality = { p_miss = 1.5 }")),
+        finding("uav[0].sensor[0].quality.p_miss", "must be a probability in (0, 1)", "1.5")
+    );
+    assert_eq!(
+        one(&camera("quality = { range_noise_std = -0.01 }")),
+        finding("uav[0].sensor[0].quality.range_noise_std", "must be at least 0", "-0.01")
+    );
+}
+
+#[test]
+fn lidar_settings() {
+    let lidar = |extra: &str| with("kind = \"depth_camera\"", &format!("kind = \"lidar\"\n{extra}"));
+    assert_eq!(findings(&lidar("hfov = 6.283185307179586")), vec![]);
+    assert_eq!(
+        one(&lidar("hfov = 6.3")),
+        finding("uav[0].sensor[0].hfov", "must be in (0, 2 pi] rad", "6.3")
+    );
+    assert_eq!(
+        one(&lidar("beams_h = 0")),
+        finding("uav[0].sensor[0].beams_h", "must be at least 1", "0")
+    );
+    assert_eq!(
+        one(&lidar("vfov = 0.3")),
+        finding(
+            "uav[0].sensor[0].vfov",
+            "must be 0 for a planar lidar (beams_v = 1); set beams_v for a multi-beam one",
+            "0.3"
+        )
+    );
+    assert_eq!(findings(&lidar("vfov = 0.5\nbeams_v = 16")), vec![]);
+    assert_eq!(
+        one(&lidar("vfov = 0.0\nbeams_v = 16")),
+        finding("uav[0].sensor[0].vfov", "must be in (0, pi) rad", "0.0")
+    );
+    let (path, _, found) = one(&lidar("beams_h = 100000\nbeams_v = 1000\nvfov = 1.0"));
+    assert_eq!(path, "uav[0].sensor[0].beams_h");
+    assert_eq!(found.as_deref(), Some("1.000e8 rays"));
+}
+
+#[test]
+fn uav_settings() {
+    assert_eq!(
+        one(&with("[1.0, 1.0, 1.0] }", "[1.0, 11.0, 1.0] }")),
+        finding(
+            "uav[0].start.position",
+            "must be inside world.bounds ([0.0, 0.0, 0.0] to [10.0, 10.0, 3.0])",
+            "[1.0, 11.0, 1.0]"
+        )
+    );
+    assert_eq!(
+        one(&with("speed = 1.0", "speed = 0.0")),
+        finding("uav[0].behaviour.speed", "must be above 0", "0.0")
+    );
+    assert_eq!(
+        one(&with("speed = 1.0", "speed = 1.0\nyaw_rate = -1.0")),
+        finding("uav[0].behaviour.yaw_rate", "must be above 0", "-1.0")
+    );
+    assert_eq!(
+        one(&with("[[5.0, 5.0, 1.0]]", "[[5.0, 5.0, 1.0], [5.0, 5.0, 4.0]]")),
+        finding(
+            "uav[0].behaviour.waypoints[1]",
+            "must be inside world.bounds ([0.0, 0.0, 0.0] to [10.0, 10.0, 3.0])",
+            "[5.0, 5.0, 4.0]"
+        )
+    );
+    assert_eq!(
+        one(&with("[[5.0, 5.0, 1.0]]", "[]")),
+        finding("uav[0].behaviour.waypoints", "must be at least one waypoint", "an empty list")
+    );
+    let (path, message, _) = one(&with("name = \"a\"", "name = \"a\"\nairframe = \"irs\""));
+    assert_eq!(path, "uav[0].airframe");
+    assert_eq!(
+        message,
+        "unknown airframe preset 'irs': this build knows: kingfisher, iris (did you mean 'iris'?)"
+    );
+}
+
+#[test]
+fn uav_set() {
+    let second = format!("{BASE}\n[[uav]]\nname = \"a\"\nstart = {{ position = [2.0, 2.0, 1.0] }}\nbehaviour = {{ kind = \"scripted\", speed = 1.0, waypoints = [[1.0, 1.0, 1.0]] }}\n");
+    assert_eq!(
+        one(&second),
+        finding(
+            "uav[1].name",
+            "must be a name no other UAV has (uav[0] is also called \"a\")",
+            "\"a\""
+        )
+    );
+    let none = &BASE[..BASE.find("[[uav]]").unwrap()];
+    let (path, message, found) = one(none);
+    assert_eq!(path, "uav");
+    assert_eq!(message, "the scenario has no UAV: add a [[uav]] table");
+    assert_eq!(found, None);
+}
+
+#[test]
+fn obstacle_sizes() {
+    let obstacle = |body: &str| format!("{BASE}\n[[world.obstacle]]\n{body}\n");
+    assert_eq!(
+        one(&obstacle("kind = \"box\"\ncenter = [5.0, 5.0, 1.0]\nsize = [1.0, 0.0, 1.0]")),
+        finding("world.obstacle[0].size[1]", "must be above 0", "0.0")
+    );
+    assert_eq!(
+        one(&obstacle("kind = \"sphere\"\ncenter = [5.0, 5.0, 1.0]\nradius = -1.0")),
+        finding("world.obstacle[0].radius", "must be above 0", "-1.0")
+    );
+    assert_eq!(
+        one(&obstacle("kind = \"cylinder\"\nbase = [5.0, 5.0, 0.0]\nradius = 0.5\nheight = 0.0")),
+        finding("world.obstacle[0].height", "must be above 0", "0.0")
+    );
+    assert_eq!(
+        one(&obstacle("kind = \"mesh\"\nfile = \"m.obj\"\nscale = 0.0")),
+        finding("world.obstacle[0].scale", "must be above 0", "0.0")
+    );
+    let pillars = "kind = \"pillars\"\nregion_min = [0.0, 0.0]\nregion_max = [10.0, 10.0]\n\
+                   radius_min = 0.1\nradius_max = 0.2\nheight = 2.0";
+    assert_eq!(findings(&obstacle(&format!("{pillars}\ndensity = 0.1"))), vec![]);
+    assert_eq!(
+        one(&obstacle(&format!("{pillars}\ndensity = 2000.0"))),
+        finding(
+            "world.obstacle[0].density",
+            "must be at most 1000.0 per m^2 here (1e5 pillars in a region of 100.0 m^2)",
+            "2000.0"
+        )
+    );
+    assert_eq!(
+        one(&obstacle(&format!("{}\ndensity = 0.1", pillars.replace("0.2", "0.05")))),
+        finding("world.obstacle[0].radius_max", "must be at least radius_min (0.1)", "0.05")
+    );
+    assert_eq!(
+        one(&obstacle(&format!(
+            "{}\ndensity = 0.1",
+            pillars.replace("region_max = [10.0, 10.0]", "region_max = [10.0, -1.0]")
+        ))),
+        finding("world.obstacle[0].region_max[1]", "must be above region_min[1] (0.0)", "-1.0")
+    );
+}
+
+#[test]
+fn non_finite_numbers_are_reported_once_by_path() {
+    let text = with("[[5.0, 5.0, 1.0]]", "[[5.0, nan, 1.0]]").replace("speed = 1.0", "speed = inf");
+    let mut all = findings(&text);
+    all.sort();
+    assert_eq!(
+        all,
+        vec![
+            finding("uav[0].behaviour.speed", "must be a finite number", "inf"),
+            finding("uav[0].behaviour.waypoints[0][1]", "must be a finite number", "NaN"),
+        ]
+    );
+    // A NaN range triggers no ordering complaint of its own.
+    let camera = with("kind = \"depth_camera\"", "kind = \"depth_camera\"\nrange_min = nan");
+    assert_eq!(
+        one(&camera),
+        finding("uav[0].sensor[0].range_min", "must be a finite number", "NaN")
+    );
+}
+
+#[test]
+fn a_seed_beyond_toml_integers_does_not_hide_non_finite_numbers() {
+    let mut scenario = scenario(&with("speed = 1.0", "speed = nan"));
+    scenario.seed = u64::MAX;
+    let paths: Vec<String> = non_finite(&scenario)
+        .iter()
+        .map(|f| f.path.to_string())
+        .collect();
+    assert_eq!(paths, ["uav[0].behaviour.speed"]);
+}

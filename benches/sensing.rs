@@ -6,7 +6,7 @@
 //!   (1,080 beams, 20 m).
 //! - `sense_and_map`: one thesis-camera frame swept and integrated into a warmed-up 0.1 m map
 //!   (all chunks exist, the steady state of a run), with the auto grid (55 x 41 = 2,255 rays)
-//!   and with one ray per pixel (307,200 rays).
+//!   and with one ray per pixel (307,200 rays); `sweep_only` is the sensing part alone.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec3, Quat, Vec3};
@@ -143,6 +143,20 @@ fn sense_and_map(c: &mut Criterion) {
         let rays = ScanRays::of(&scan);
         integrate_scan(&map, id, rays, increments, &mut store, &mut totals).unwrap();
         group.throughput(Throughput::Elements(pattern.directions.len() as u64));
+        group.bench_function(BenchmarkId::new("sweep_only", name), |b| {
+            b.iter(|| {
+                sweep(
+                    &pattern,
+                    facing_pillar(),
+                    &world,
+                    None,
+                    &mut scratch,
+                    &mut scan,
+                    0.0,
+                );
+                black_box(scan.endpoints.len())
+            })
+        });
         group.bench_function(BenchmarkId::new("thesis_camera_frame", name), |b| {
             b.iter(|| {
                 sweep(

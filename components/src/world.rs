@@ -9,6 +9,7 @@
 mod ground_truth;
 mod rays;
 
+pub use ground_truth::VOXEL_SHRINK;
 pub use rays::PARALLEL_RAY_THRESHOLD;
 
 use bevy_ecs::prelude::*;

@@ -6,4 +6,5 @@ pub mod output;
 pub mod run;
 pub mod scenario;
 pub mod sim;
+pub mod sweep;
 pub mod world;

@@ -59,11 +59,11 @@ pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, 
     // The world may be mid-tick after a panic; what it recorded until then is still valid.
     let mut summary = summarise(&mut sim, &loaded.scenario.name, seed, outcome, reason);
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    if let Some(dir) = &options.out_dir {
-        if let Err(e) = write_outputs(&mut sim, &summary, dir, loaded.scenario.outputs.export_map) {
-            summary.outcome = Outcome::Failed;
-            summary.reason = format!("could not write results to {}: {e}", dir.display());
-        }
+    if let Some(dir) = &options.out_dir
+        && let Err(e) = write_outputs(&mut sim, &summary, dir, loaded.scenario.outputs.export_map)
+    {
+        summary.outcome = Outcome::Failed;
+        summary.reason = format!("could not write results to {}: {e}", dir.display());
     }
     Ok(summary)
 }

@@ -7,15 +7,18 @@ use parry3d::query::Ray;
 use rayon::prelude::*;
 
 /// Batches at least this long are cast on the rayon pool, in chunks of
-/// [`PARALLEL_RAY_CHUNK`] rays. Below it the fork/join overhead (a few microseconds) is not won
-/// back: a Pillars-scene ray costs about a quarter of a microsecond (benches/sensing.rs). Each
-/// ray's result depends on that ray alone, so the split never changes a result.
+/// `PARALLEL_RAY_CHUNK` rays. A Pillars-scene ray costs about 0.2 us (benches/sensing.rs), so
+/// such a batch is ~1 ms of work, far above rayon's fork/join cost; shorter batches (the auto
+/// grid's 2,255 rays of the EAAE camera) stay serial, since sweeps of many runs already keep
+/// every core busy with whole runs (DESIGN.md, "Runs, sweeps and scale"). Each ray's result
+/// depends on that ray alone, so the split never changes a result.
 pub const PARALLEL_RAY_THRESHOLD: usize = 4096;
 const PARALLEL_RAY_CHUNK: usize = 1024;
 
 impl WorldGeometry {
     /// Distance from `origin` along the unit vector `dir` to the first obstacle surface, if one
-    /// lies within `max_distance`. A ray starting inside a solid obstacle hits at distance 0.
+    /// lies within `max_distance`. A ray starting inside a box, cylinder, sphere, ball of a cloud
+    /// or the ground hits at distance 0 (a sensor inside a wall sees nothing).
     pub fn cast_ray(&self, origin: Vec3, dir: Vec3, max_distance: f32) -> Option<f32> {
         self.cast_ray_and_get_obstacle(origin, dir, max_distance)
             .map(|(_, distance)| distance)

@@ -108,6 +108,10 @@ fn ray_misses_beyond_max_distance_and_reports_the_nearest_obstacle() {
     assert!((d - 2.5).abs() < EPS);
     assert_eq!(w.cast_ray(Vec3::ZERO, -Vec3::X, 20.0), None);
     assert_eq!(
+        w.cast_ray(Vec3::new(3.0, 0.2, 0.0), Vec3::Y, 20.0),
+        Some(0.0)
+    );
+    assert_eq!(
         WorldGeometry::empty().cast_ray(Vec3::ZERO, Vec3::X, 20.0),
         None
     );

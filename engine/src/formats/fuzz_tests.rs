@@ -16,6 +16,9 @@ const PLY_ASCII: &[u8] = include_bytes!("../../tests/data/points_ascii.ply");
 const PLY_LE: &[u8] = include_bytes!("../../tests/data/points_binary_le.ply");
 const PLY_BE: &[u8] = include_bytes!("../../tests/data/points_binary_be.ply");
 
+/// Whether one reader accepts some bytes.
+type Accepts = fn(&[u8]) -> bool;
+
 /// Every reader on `bytes`; true for each that accepted them. Panics propagate (and fail).
 fn run_all(bytes: &[u8]) -> [bool; 5] {
     [
@@ -98,7 +101,7 @@ proptest! {
     fn truncated_fixtures_are_errors(cut in any::<prop::sample::Index>()) {
         // Formats that declare their size: any strict prefix is an error.
         let bt = bt_fixture();
-        let sized: [(&[u8], fn(&[u8]) -> bool); 6] = [
+        let sized: [(&[u8], Accepts); 6] = [
             (CUBE_STL_BINARY, |b| stl::parse_stl(b).is_ok()),
             (PCD_BINARY, |b| pcd::parse_pcd(b).is_ok()),
             (PCD_COMPRESSED, |b| pcd::parse_pcd(b).is_ok()),
@@ -111,7 +114,7 @@ proptest! {
             prop_assert!(!parses(&bytes[..n]), "prefix of {} bytes of {} accepted", n, bytes.len());
         }
         // Text formats: cutting before the last record is an error; any cut never panics.
-        let text: [(&[u8], &[u8], fn(&[u8]) -> bool); 4] = [
+        let text: [(&[u8], &[u8], Accepts); 4] = [
             (CUBE_STL_ASCII, b"endsolid", |b| stl::parse_stl(b).is_ok()),
             (PCD_ASCII, b"0.25 -0.5 1.5", |b| pcd::parse_pcd(b).is_ok()),
             (PLY_ASCII, b"0.25 -0.5 1.5", |b| ply::parse_ply_points(b).is_ok()),

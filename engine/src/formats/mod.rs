@@ -16,6 +16,7 @@
 //! reads well but its ASCII errors carry no line.
 
 pub mod cloud;
+mod lzf;
 pub mod mesh;
 pub mod obj;
 pub mod octomap;

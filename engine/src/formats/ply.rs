@@ -89,6 +89,18 @@ pub(crate) fn parse_ply_points(bytes: &[u8]) -> Result<PointCloud, Fault> {
             }
         }
     }
+    // An element without properties takes no bytes: a corrupt count of billions would spin
+    // (and allocate) without reading anything. No writer produces one.
+    if let Some((name, _)) = header
+        .elements
+        .iter()
+        .find(|(_, e)| e.count > 0 && e.properties.is_empty())
+    {
+        return Err(Fault::at(
+            header_lines,
+            format!("element {name:?} has no properties"),
+        ));
+    }
     if header.encoding == Encoding::Ascii {
         return read_ascii(&bytes[body_start..], header_lines, &header, axes);
     }
@@ -271,5 +283,14 @@ mod tests {
         bytes.truncate(bytes.len() - 1);
         let f = parse_ply_points(&bytes).unwrap_err();
         assert_eq!(f.line, None);
+        let src = "ply\nformat binary_little_endian 1.0\nelement camera 4000000000\n\
+                   element vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n";
+        let f = parse_ply_points(src.as_bytes()).unwrap_err();
+        assert_eq!(f.line, Some(8));
+        assert!(
+            f.problem
+                .to_string()
+                .contains("\"camera\" has no properties")
+        );
     }
 }

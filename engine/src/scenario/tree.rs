@@ -172,6 +172,33 @@ impl Node {
         }
     }
 
+    /// The value at `segments` below this node, for editing.
+    pub fn get_mut(&mut self, segments: &[Segment]) -> Option<&mut Node> {
+        segments
+            .iter()
+            .try_fold(self, |node, segment| node.child_mut(segment))
+    }
+
+    /// Keeps the first `count` values of a table or an array (in file order) and drops the
+    /// rest; a table's `kind` tag is kept when it is a string (see `decode::blame`), and
+    /// `count` does not include it.
+    pub fn keep_first(&mut self, count: usize) {
+        match &mut self.value {
+            Value::Table(entries) => {
+                let mut kept = 0;
+                entries.retain(|entry| {
+                    if entry.key == "kind" && matches!(entry.node.value, Value::String(_)) {
+                        return true;
+                    }
+                    kept += 1;
+                    kept <= count
+                });
+            }
+            Value::Array(elements) => elements.truncate(count),
+            _ => {}
+        }
+    }
+
     fn child_mut(&mut self, segment: &Segment) -> Option<&mut Node> {
         match (&mut self.value, segment) {
             (Value::Table(entries), Segment::Key(key)) => entries
@@ -186,11 +213,16 @@ impl Node {
         }
     }
 
-    /// The direct children with their paths (`at` names this node).
+    /// The direct children with their paths (`at` names this node), in file order; a
+    /// table's `kind` tag is left out when it is a string (it selects the type of the table
+    /// rather than being one of its values; see `keep_first`).
     pub fn children(&self, at: &FieldPath) -> Vec<(FieldPath, &Node)> {
         match &self.value {
             Value::Table(entries) => entries
                 .iter()
+                .filter(|entry| {
+                    !(entry.key == "kind" && matches!(entry.node.value, Value::String(_)))
+                })
                 .map(|entry| (at.key(&entry.key), &entry.node))
                 .collect(),
             Value::Array(elements) => elements

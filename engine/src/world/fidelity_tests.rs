@@ -6,7 +6,7 @@
 use super::build_world;
 use crate::scenario::WorldSpec;
 use glam::{DVec3, IVec3, Quat, Vec3};
-use std::collections::BTreeMap;
+use std::collections::{HashMap, HashSet};
 use std::path::Path;
 use uavex_components::map::{MapConfig, MapSettings, ScanId, VoxelState};
 use uavex_components::sensor::{Scan, SensorQuality};
@@ -78,7 +78,7 @@ pub(super) fn pillars_world() -> (WorldSpec, WorldGeometry) {
 /// Camera poses: in front of each pillar, along a wall, looking into a corner (position, yaw).
 const POSES: [([f32; 3], f32); 6] = [
     ([0.0, 0.0, 1.0], 0.0),
-    ([0.0, -2.5, 1.2], -1.5708),
+    ([0.0, -2.5, 1.2], -std::f32::consts::FRAC_PI_2),
     ([2.0, 2.0, 1.0], 0.785),
     ([-2.0, 1.5, 1.5], 2.2),
     ([7.0, -7.0, 1.0], -0.785),
@@ -91,7 +91,7 @@ fn map_of_frames(
     world: &WorldGeometry,
     spec: &WorldSpec,
     pattern: &RayPattern,
-) -> BTreeMap<IVec3, VoxelState> {
+) -> HashMap<IVec3, VoxelState> {
     let config = MapConfig::new(&MapSettings {
         resolution: 0.1,
         bounds_min: DVec3::from_array(spec.bounds.min),
@@ -130,6 +130,47 @@ fn map_of_frames(
         .collect()
 }
 
+/// How well a coarse map reproduces a fine one.
+#[derive(Debug)]
+struct Agreement {
+    /// Voxels known in both / known in the fine map.
+    known: f64,
+    /// Voxels known in both with the same state / known in the fine map.
+    same_state: f64,
+    /// Occupied in both / occupied in the fine map.
+    occupied: f64,
+    /// Voxels known in the coarse map only / known in the coarse map.
+    extra: f64,
+}
+
+fn agreement(fine: &HashMap<IVec3, VoxelState>, coarse: &HashMap<IVec3, VoxelState>) -> Agreement {
+    let both = fine.keys().filter(|k| coarse.contains_key(k)).count();
+    let same = fine
+        .iter()
+        .filter(|(k, s)| coarse.get(k) == Some(s))
+        .count();
+    let occupied = |m: &HashMap<IVec3, VoxelState>| {
+        m.iter()
+            .filter(|(_, s)| **s == VoxelState::Occupied)
+            .map(|(k, _)| *k)
+            .collect::<HashSet<_>>()
+    };
+    let (occ_fine, occ_coarse) = (occupied(fine), occupied(coarse));
+    let occ_both = occ_fine.intersection(&occ_coarse).count();
+    Agreement {
+        known: both as f64 / fine.len() as f64,
+        same_state: same as f64 / fine.len() as f64,
+        occupied: occ_both as f64 / occ_fine.len() as f64,
+        extra: (coarse.len() - both) as f64 / coarse.len() as f64,
+    }
+}
+
+/// Measured (6 poses, 0.1 m map): per pixel 307,200 rays mark 122,611 voxels (4,682 occupied);
+/// the auto grid's 2,255 rays mark 118,282 of them plus 1 other: 96.5 % of the voxels, 96.1 %
+/// with the same state, 89.0 % of the occupied ones (the misses are surfaces seen at grazing
+/// angles, where rays one voxel apart across the view land further apart along the surface).
+/// A grid at twice the auto step (28 x 21 rays) falls to 75.9 % of the voxels and 38.3 % of the
+/// occupied ones, so the thresholds separate "matched to the voxel size" from merely "coarse".
 #[test]
 fn auto_grid_marks_the_voxels_one_ray_per_pixel_marks() {
     let (spec, world) = pillars_world();
@@ -138,49 +179,34 @@ fn auto_grid_marks_the_voxels_one_ray_per_pixel_marks() {
         height: 480,
         hfov: 1.0,
     };
-    let auto = camera_pattern(camera, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).unwrap();
-    let grid = RayGrid::Explicit {
+    let pattern = |grid| camera_pattern(camera, grid, 0.5, 5.0).unwrap();
+    let auto = pattern(RayGrid::Auto { resolution: 0.1 });
+    let per_pixel = pattern(RayGrid::Explicit {
         columns: 640,
         rows: 480,
-    };
-    let per_pixel = camera_pattern(camera, grid, 0.5, 5.0).unwrap();
-    let coarse = map_of_frames(&world, &spec, &auto);
+    });
+    let half = pattern(RayGrid::Explicit {
+        columns: 28,
+        rows: 21,
+    });
     let fine = map_of_frames(&world, &spec, &per_pixel);
-
-    let both = fine.keys().filter(|k| coarse.contains_key(k)).count();
-    let union = fine.len() + coarse.len() - both;
-    let same_state = fine
-        .iter()
-        .filter(|(k, s)| coarse.get(k) == Some(s))
-        .count();
-    let occupied = |m: &BTreeMap<IVec3, VoxelState>| {
-        m.iter()
-            .filter(|(_, s)| **s == VoxelState::Occupied)
-            .map(|(k, _)| *k)
-            .collect::<std::collections::BTreeSet<_>>()
-    };
-    let (occ_fine, occ_coarse) = (occupied(&fine), occupied(&coarse));
-    let occ_both = occ_fine.intersection(&occ_coarse).count();
-    let coverage = both as f64 / fine.len() as f64;
-    let jaccard = both as f64 / union as f64;
-    let agreement = same_state as f64 / fine.len() as f64;
-    let occ_coverage = occ_both as f64 / occ_fine.len() as f64;
+    let matched = agreement(&fine, &map_of_frames(&world, &spec, &auto));
+    let coarser = agreement(&fine, &map_of_frames(&world, &spec, &half));
     println!(
-        "per pixel: {} rays, {} voxels ({} occupied); auto: {} rays, {} voxels ({} occupied)",
-        per_pixel.directions.len(),
-        fine.len(),
-        occ_fine.len(),
-        auto.directions.len(),
-        coarse.len(),
-        occ_coarse.len()
-    );
-    println!(
-        "known by both / per pixel = {coverage:.4}, Jaccard = {jaccard:.4}, same state / per \
-         pixel = {agreement:.4}, occupied by both / occupied per pixel = {occ_coverage:.4}"
+        "per pixel: {} voxels known; auto {matched:?}; half {coarser:?}",
+        fine.len()
     );
     assert!(fine.len() > 100_000, "the frames must see a real scene");
     assert!(
-        coverage > 0.0,
-        "placeholder: thresholds set from the measured values"
+        matched.known > 0.95 && matched.same_state > 0.95,
+        "{matched:?}"
+    );
+    assert!(
+        matched.occupied > 0.85 && matched.extra < 0.01,
+        "{matched:?}"
+    );
+    assert!(
+        coarser.known < 0.85 && coarser.occupied < 0.5,
+        "{coarser:?}"
     );
 }

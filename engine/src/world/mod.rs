@@ -21,7 +21,7 @@ use crate::scenario::{ObstacleSpec, WorldSpec};
 use glam::Vec3;
 use std::path::Path;
 use uavex_components::sim::RunSeed;
-use uavex_components::world::{Obstacle, WorldGeometry};
+use uavex_components::world::{Obstacle, WorldGeometry, WorldGeometryError};
 
 /// A problem with the scenario found while building the world: the field it concerns and what
 /// is wrong.
@@ -76,7 +76,10 @@ pub fn build_world(
     if !errors.is_empty() {
         return Err(errors);
     }
-    WorldGeometry::new(obstacles).map_err(|e| vec![BuildError::new("world", e.to_string())])
+    WorldGeometry::new(obstacles).map_err(|e| {
+        let WorldGeometryError::NotFinite { source_field, .. } = &e;
+        vec![BuildError::new(source_field.clone(), e.to_string())]
+    })
 }
 
 /// Refuses UAV starts that put a ball of `body_radius` (the airframe's bounding sphere) into an
@@ -91,8 +94,8 @@ pub fn check_starts(world: &WorldGeometry, starts: &[Vec3], body_radius: f32) ->
             Some(BuildError::new(
                 format!("uav[{i}].start.position"),
                 format!(
-                    "the UAV (radius {body_radius} m) at ({}, {}, {}) starts inside obstacle \
-                     '{}' ({})",
+                    "the UAV (radius {body_radius} m) at ({}, {}, {}) starts inside or within \
+                     its radius of obstacle '{}' ({})",
                     start.x, start.y, start.z, obstacle.name, obstacle.source
                 ),
             ))

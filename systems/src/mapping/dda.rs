@@ -20,12 +20,14 @@ const NEVER: f64 = f64::INFINITY;
 const TIME_CAP: f64 = 1e290;
 
 /// A segment clipped to a key box: the keys it starts and ends in.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ClippedSegment {
     pub start_key: IVec3,
     pub end_key: IVec3,
     /// Whether the segment's own end point lies in the box (else it was cut at the box).
     pub end_inside: bool,
+    /// Segment parameter (0 at the start, 1 at the end) where the clipped segment ends.
+    pub t_end: f64,
 }
 
 /// Clips the segment `start -> end` (voxel units) to the keys `lo..=hi`; `None` if it misses the
@@ -59,6 +61,7 @@ pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<Cl
         start_key: if start_inside { raw_start } else { key_at(t0) },
         end_key: if end_inside { raw_end } else { key_at(t1) },
         end_inside,
+        t_end: t1,
     })
 }
 
@@ -113,28 +116,66 @@ impl VoxelWalk {
         self.remaining.iter().map(|&r| u64::from(r)).sum()
     }
 
-    /// Moves to the next voxel; returns the axis moved along and the step (+1 or -1).
+    /// Step (+1, -1 or 0) of the walk along each axis.
+    #[inline]
+    pub fn steps(&self) -> [i32; 3] {
+        self.step
+    }
+
+    /// Segment parameter of the next boundary on each axis (infinite for axes with no step
+    /// left).
+    #[inline]
+    pub fn boundary_times(&self) -> [f64; 3] {
+        self.t_max
+    }
+
+    /// Segment parameter between two boundaries on each axis.
+    #[inline]
+    pub fn boundary_intervals(&self) -> [f64; 3] {
+        self.t_delta
+    }
+
+    /// Continues the walk at `key` with next boundary times `t_max`, after a caller's own loop
+    /// (see `integrate`) took steps along the walk's axes without bookkeeping of their counts.
+    pub fn resume(&mut self, key: IVec3, t_max: [f64; 3]) {
+        for axis in 0..3 {
+            let taken = (key[axis] - self.key[axis]).unsigned_abs();
+            self.remaining[axis] = self.remaining[axis].saturating_sub(taken);
+            self.t_max[axis] = if self.remaining[axis] == 0 {
+                NEVER
+            } else {
+                t_max[axis]
+            };
+            self.key[axis] = key[axis];
+        }
+    }
+
+    /// Moves to the next voxel; returns which axis it moved along (exactly one is `true`).
     /// Only meaningful while [`Self::steps_left`] > 0.
     ///
-    /// The axis is the one with the earliest boundary (ties go to x, then y, then z), chosen
-    /// with selects rather than branches: which axis comes next is as good as random, so a
-    /// branch would be mispredicted about every other step.
+    /// The axis is the one with the earliest boundary (ties go to x, then y, then z). Which
+    /// axis comes next is as good as random, so it is chosen with comparisons and selects on
+    /// all three axes rather than a branch (mispredicted about every other step) or an index
+    /// by a run-time axis (which would keep the walk's state in memory instead of registers).
     #[inline(always)]
-    pub fn step(&mut self) -> (usize, i32) {
+    pub fn advance(&mut self) -> [bool; 3] {
         let t = self.t_max;
-        let first_of_xy = usize::from(t[1] < t[0]);
-        let axis = if t[2] < t[0].min(t[1]) {
-            2
-        } else {
-            first_of_xy
-        };
-        let remaining = self.remaining[axis].saturating_sub(1);
-        self.remaining[axis] = remaining;
-        let next = t[axis] + self.t_delta[axis];
-        self.t_max[axis] = if remaining == 0 { NEVER } else { next };
-        let step = self.step[axis];
-        self.key[axis] += step;
-        (axis, step)
+        let x = (t[0] <= t[1]) & (t[0] <= t[2]);
+        let y = !x & (t[1] <= t[2]);
+        let moved = [x, y, !x & !y];
+        for axis in 0..3 {
+            let m = moved[axis];
+            let remaining = self.remaining[axis].saturating_sub(u32::from(m));
+            self.remaining[axis] = remaining;
+            let next = if m {
+                t[axis] + self.t_delta[axis]
+            } else {
+                t[axis]
+            };
+            self.t_max[axis] = if remaining == 0 { NEVER } else { next };
+            self.key[axis] += if m { self.step[axis] } else { 0 };
+        }
+        moved
     }
 }
 
@@ -148,7 +189,7 @@ pub fn for_each_key(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3, mut visit: i
     let mut walk = VoxelWalk::new(start, end, clip.start_key, clip.end_key);
     visit(walk.key());
     for _ in 0..walk.steps_left() {
-        walk.step();
+        walk.advance();
         visit(walk.key());
     }
 }
@@ -339,8 +380,8 @@ mod tests {
         )
         .unwrap();
         assert_eq!(
-            (c.start_key, c.end_key, c.end_inside),
-            (IVec3::new(-20, 0, 0), IVec3::ZERO, true)
+            (c.start_key, c.end_key, c.end_inside, c.t_end),
+            (IVec3::new(-20, 0, 0), IVec3::ZERO, true, 1.0)
         );
         let c = clip_segment(
             DVec3::new(0.5, 0.5, 0.5),
@@ -350,6 +391,7 @@ mod tests {
         )
         .unwrap();
         assert_eq!((c.end_key, c.end_inside), (IVec3::new(0, 19, 0), false));
+        assert!((c.t_end - 19.5 / 39.5).abs() < 1e-15);
         // An end exactly on the upper face lies outside (half-open box): the segment is cut.
         let c = clip_segment(DVec3::splat(0.5), DVec3::new(0.5, 20.0, 0.5), LO, HI).unwrap();
         assert_eq!((c.end_key, c.end_inside), (IVec3::new(0, 19, 0), false));

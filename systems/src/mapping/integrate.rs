@@ -23,7 +23,7 @@ use uavex_components::sensor::Scan;
 /// exactly on a voxel face lands in the obstacle's voxel, not the free one in front of it.
 pub const HIT_NUDGE: f64 = 1e-3;
 
-/// Index step inside a chunk for a step along x, y, z (see `local_index`).
+/// Index step inside a chunk for a +1 step along x, y, z (see `local_index`).
 const STRIDE: [isize; 3] = [1, CHUNK_EDGE as isize, (CHUNK_EDGE * CHUNK_EDGE) as isize];
 
 /// Mutable access to the map's chunks, by flat chunk index (see [`ChunkGrid::flat`]).
@@ -118,6 +118,7 @@ pub fn integrate_scan(
     for (end, _) in ends().filter(|&(_, hit)| hit) {
         let key = floor_to_key(end);
         if config.contains_key(key) {
+            run.report.voxel_visits += 1;
             run.update_one(key, hit_rule);
         }
     }
@@ -131,7 +132,7 @@ pub fn integrate_scan(
         let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
         let exclude_end = hit && clip.end_inside;
         let visits = walk.steps_left() + 1 - u64::from(exclude_end);
-        run.update_walk(walk, visits, miss_rule);
+        run.update_walk(walk, clip.t_end, visits, miss_rule);
     }
     Ok(run.report)
 }
@@ -188,48 +189,142 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let voxel = &mut chunk.voxels_mut()[local_index(key) & (CHUNK_VOXELS - 1)];
         let changed = update_voxel(voxel, rule, self.tables, stats);
         self.totals.add_change(&before, stats);
-        self.report.voxel_visits += 1;
         if changed {
             self.report.changed_voxels += 1;
             self.chunks.mark_written(flat);
         }
     }
 
-    /// Updates the first `visits` voxels of `walk` (all inside the map). The inner loop runs
-    /// while the walk stays inside one chunk: integer index stepping, no lookups, no bounds
-    /// checks (the index is masked to the chunk, which it never leaves anyway).
-    fn update_walk(&mut self, mut walk: VoxelWalk, mut visits: u64, rule: UpdateRule) {
+    /// Updates the first `visits` voxels of `walk` (all inside the map), whose segment ends at
+    /// parameter `t_end`.
+    ///
+    /// Most steps run in [`Self::walk_fast`]; the last steps, whose boundaries lie within
+    /// [`END_MARGIN`] of the end (where rounding could order a boundary beyond the end key
+    /// before a real one), take the counted walk of [`VoxelWalk::advance`], voxel by voxel.
+    fn update_walk(&mut self, mut walk: VoxelWalk, t_end: f64, visits: u64, rule: UpdateRule) {
         self.report.voxel_visits += visits;
+        // `walk` stays at the last voxel updated.
+        let mut visits = self.walk_fast(&mut walk, t_end - END_MARGIN, visits, rule);
         while visits > 0 {
-            let key = walk.key();
+            walk.advance();
+            self.update_one(walk.key(), rule);
+            visits -= 1;
+        }
+    }
+
+    /// Walks and updates voxels while the next boundary comes before `t_safe`; returns the
+    /// visits left, with `walk` moved to the last voxel updated.
+    ///
+    /// No step taken here can overshoot the end key: every boundary crossed lies before the
+    /// segment's end, so no per-axis step counts are needed. The inner loop runs while the walk
+    /// stays in one chunk and keeps everything in registers: the axis is chosen with compares
+    /// and selects (which axis comes next is as good as random, a branch would be mispredicted
+    /// every other step), and one integer `cursor` holds both the voxel index in the chunk and
+    /// the chunk-local coordinates, each biased so that leaving the chunk shows in one mask
+    /// test. No lookups, no bounds checks.
+    fn walk_fast(
+        &mut self,
+        walk: &mut VoxelWalk,
+        t_safe: f64,
+        mut visits: u64,
+        rule: UpdateRule,
+    ) -> u64 {
+        let [mut tx, mut ty, mut tz] = walk.boundary_times();
+        let [dtx, dty, dtz] = walk.boundary_intervals();
+        let [mx, my, mz] = walk.steps().map(|step| step as i64);
+        let [cx, cy, cz] = [mx * CURSOR_X, my * CURSOR_Y, mz * CURSOR_Z].map(|d| d as u64);
+        let mut key = walk.key();
+        let mut stop = false;
+        while visits > 0 && !stop {
             let coord = ChunkCoord::of_key(key);
             let flat = self.grid.flat_unchecked(coord);
             let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
             chunk.begin_scan(self.scan);
             let before = *stats;
             let voxels = chunk.voxels_mut();
-            let mut local = (key & (CHUNK_EDGE - 1)).to_array();
-            let mut index = local_index(key);
+            let mut cursor = Cursor::at(key);
             let mut changed = 0u64;
             loop {
-                let voxel = &mut voxels[index & (CHUNK_VOXELS - 1)];
+                let voxel = &mut voxels[cursor.index()];
                 changed += u64::from(update_voxel(voxel, rule, self.tables, stats));
                 visits -= 1;
                 if visits == 0 {
                     break;
                 }
-                let (axis, step) = walk.step();
-                local[axis] += step;
-                if local[axis] as u32 >= CHUNK_EDGE as u32 {
+                if (tx >= t_safe) & (ty >= t_safe) & (tz >= t_safe) {
+                    stop = true;
                     break;
                 }
-                index = index.wrapping_add_signed(STRIDE[axis] * step as isize);
+                let x = (tx <= ty) & (tx <= tz);
+                let y = !x & (ty <= tz);
+                let z = !x & !y;
+                tx += if x { dtx } else { 0.0 };
+                ty += if y { dty } else { 0.0 };
+                tz += if z { dtz } else { 0.0 };
+                cursor.0 = cursor.0.wrapping_add(if x {
+                    cx
+                } else if y {
+                    cy
+                } else {
+                    cz
+                });
+                if cursor.left_chunk() {
+                    break;
+                }
             }
+            key = coord.first_key() + cursor.local();
             self.totals.add_change(&before, stats);
             if changed > 0 {
                 self.report.changed_voxels += changed;
                 self.chunks.mark_written(flat);
             }
         }
+        walk.resume(key, [tx, ty, tz]);
+        visits
+    }
+}
+
+/// How close to the end of a segment (in segment parameter) a boundary must come to be left
+/// to the counted walk. Accumulated rounding of the boundary times is below 1e-10 even after
+/// 10^6 steps, so a boundary computed before `t_end - END_MARGIN` really lies before the end.
+const END_MARGIN: f64 = 1e-9;
+
+/// Cursor step for +1 along x, y, z: the voxel index stride in the low 32 bits, and +1 in the
+/// byte of the axis' local coordinate in the high 32 bits.
+const CURSOR_X: i64 = (1 << 32) + STRIDE[0] as i64;
+const CURSOR_Y: i64 = (1 << 40) + STRIDE[1] as i64;
+const CURSOR_Z: i64 = (1 << 48) + STRIDE[2] as i64;
+
+/// Position inside a chunk: the voxel index plus [`CHUNK_VOXELS`] in the low 32 bits (so a
+/// step out of the chunk never borrows from the high half), and local x, y, z plus 16 in bytes
+/// 4, 5, 6 (in 16..=31 inside the chunk, 15 or 32 just outside: the high nibble tells).
+#[derive(Clone, Copy)]
+struct Cursor(u64);
+
+impl Cursor {
+    const BIAS: u64 = 0x0010_1010_0000_0000 + CHUNK_VOXELS as u64;
+    const NIBBLES: u64 = 0x00F0_F0F0_0000_0000;
+    const INSIDE: u64 = 0x0010_1010_0000_0000;
+
+    #[inline(always)]
+    fn at(key: IVec3) -> Self {
+        let l = (key & (CHUNK_EDGE - 1)).as_u64vec3();
+        Self(Self::BIAS + local_index(key) as u64 + (l.x << 32) + (l.y << 40) + (l.z << 48))
+    }
+
+    #[inline(always)]
+    fn index(self) -> usize {
+        (self.0 as usize) & (CHUNK_VOXELS - 1)
+    }
+
+    #[inline(always)]
+    fn left_chunk(self) -> bool {
+        self.0 & Self::NIBBLES != Self::INSIDE
+    }
+
+    /// Local coordinates (-1 or 16 on the axis just stepped out of the chunk).
+    fn local(self) -> IVec3 {
+        let byte = |shift: u64| ((self.0 >> shift) & 0xFF) as i32 - CHUNK_EDGE;
+        IVec3::new(byte(32), byte(40), byte(48))
     }
 }

@@ -1,10 +1,12 @@
 //! Tests of scan integration over a plain [`ChunkStore`] (no World): log-odds semantics of
 //! common.md §1 and exactness of the incremental statistics.
 
+use super::dda::for_each_key;
 use super::*;
 use glam::{DVec3, IVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
+use std::collections::BTreeSet;
 use uavex_components::map::{
     LogOddsIncrements, MapConfig, MapSettings, MapTotals, ScanCounter, StatSums, VoxelState,
 };
@@ -372,4 +374,56 @@ fn incremental_statistics_equal_a_recount() {
     assert!((metrics.mean_entropy_box - (h + box_voxels - n) / box_voxels).abs() < 1e-6);
     let total_u = u + 0.25 * (box_voxels - n);
     assert!((metrics.uncertainty_total - total_u).abs() < 1e-3);
+}
+
+/// A one-ray scan updates exactly the voxels of the traversal (common.md §1): the DDA's voxels
+/// of the clipped segment, minus the end voxel of a hit inside the map, plus that voxel as the
+/// hit. Random rays inside and across the map, with ends on voxel boundaries (the last steps
+/// then run in the counted tail of the walk) and off them.
+#[test]
+fn a_scan_updates_exactly_the_traversed_voxels() {
+    let config = config();
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    for i in 0..600 {
+        let mut point = |snap: bool| {
+            let p = Vec3::new(
+                rng.random_range(-4.0..4.0),
+                rng.random_range(-4.0..4.0),
+                rng.random_range(-4.0..4.0),
+            );
+            // Snap to the 0.1 m grid on some axes: ends exactly on voxel faces and edges.
+            if snap { (p * 10.0).round() / 10.0 } else { p }
+        };
+        let origin = point(i % 5 == 0);
+        let end = point(i % 3 != 0);
+        let hit = i % 2 == 0;
+        let mut m = Mapper::new();
+        m.scan(origin, &[(end, hit)]);
+
+        let (o, e) = (config.to_voxel_units(origin), config.to_voxel_units(end));
+        let target = if hit && e != o {
+            e + (e - o).normalize() * 1e-3
+        } else {
+            e
+        };
+        let mut expected = BTreeSet::new();
+        for_each_key(o, target, config.key_min(), config.key_max(), |k| {
+            expected.insert((k.to_array(), -405));
+        });
+        let hit_key = floor_key(target);
+        if hit && config.contains_key(hit_key) {
+            expected.retain(|(k, _)| *k != hit_key.to_array());
+            expected.insert((hit_key.to_array(), 847));
+        }
+        let known: BTreeSet<([i32; 3], i16)> = m
+            .store
+            .known_voxels()
+            .map(|(k, l)| (k.to_array(), (l * 1000.0).round() as i16))
+            .collect();
+        assert_eq!(known, expected, "ray {i}: {origin} -> {end}, hit {hit}");
+    }
+}
+
+fn floor_key(q: DVec3) -> IVec3 {
+    q.floor().as_ivec3()
 }

@@ -16,7 +16,7 @@ use super::LoadedScenario;
 use super::decode::Decoded;
 use super::diagnostic::{Diagnostic, Finding, number};
 use super::path::FieldPath;
-use super::schema::{ObstacleSpec, Scenario, SensorSpec, UavSpec};
+use super::schema::{BoundsSpec, MapSpec, ObstacleSpec, Scenario, SensorSpec, UavSpec};
 use super::source_map::Anchor;
 
 pub(crate) use numbers::non_finite;
@@ -43,16 +43,21 @@ pub const KNOWN_AIRFRAMES: &[&str] = &["kingfisher", "iris"];
 pub fn check(loaded: &LoadedScenario) -> Vec<Diagnostic> {
     let mut findings = non_finite(&loaded.scenario);
     findings.extend(check_parts(&Parts::of(&loaded.scenario)));
-    findings
+    let mut diagnostics: Vec<Diagnostic> = findings
         .into_iter()
         .map(|finding| finding.locate(&loaded.path, &loaded.source))
-        .collect()
+        .collect();
+    diagnostics.sort_by_key(|d| (d.line, d.column));
+    diagnostics
 }
 
 /// The decoded pieces of a scenario, each with its index in the file.
 pub(crate) struct Parts<'a> {
     /// The top level; its `uavs` and `world.obstacles` are not read (see the lists below).
     pub root: Option<&'a Scenario>,
+    /// The map and the bounds, also when the top level as a whole did not decode.
+    pub map: Option<&'a MapSpec>,
+    pub bounds: Option<&'a BoundsSpec>,
     pub obstacles: Vec<(usize, &'a ObstacleSpec)>,
     pub uavs: Vec<UavPart<'a>>,
     /// `[[uav]]` entries in the file, decoded or not.
@@ -71,6 +76,8 @@ impl<'a> Parts<'a> {
     pub fn of(scenario: &'a Scenario) -> Self {
         Self {
             root: Some(scenario),
+            map: Some(&scenario.map),
+            bounds: Some(&scenario.world.bounds),
             obstacles: scenario.world.obstacles.iter().enumerate().collect(),
             uavs: scenario
                 .uavs
@@ -90,6 +97,8 @@ impl<'a> Parts<'a> {
     pub fn of_decoded(decoded: &'a Decoded) -> Self {
         Self {
             root: decoded.root.as_ref(),
+            map: decoded.map.as_ref(),
+            bounds: decoded.bounds.as_ref(),
             obstacles: decoded
                 .obstacles
                 .iter()
@@ -116,14 +125,18 @@ impl<'a> Parts<'a> {
 /// Every semantic finding of `parts`, in the order of the file's sections.
 pub(crate) fn check_parts(parts: &Parts<'_>) -> Vec<Finding> {
     let mut out = Vec::new();
-    let context = world::Context::of(parts.root);
+    let context = world::Context::of(parts.map, parts.bounds);
     if let Some(root) = parts.root {
         world::check_run(root, &mut out);
-        world::check_map(&root.map, &mut out);
-        world::check_bounds(&root.world.bounds, &mut out);
-        if context.bounds.is_some() {
-            world::check_resolution(&root.map, &root.world.bounds, &mut out);
-        }
+    }
+    if let Some(map) = parts.map {
+        world::check_map(map, &mut out);
+    }
+    if let Some(bounds) = parts.bounds {
+        world::check_bounds(bounds, &mut out);
+    }
+    if let (Some(map), Some(bounds)) = (parts.map, context.bounds.as_ref()) {
+        world::check_resolution(map, bounds, &mut out);
     }
     for (index, obstacle) in &parts.obstacles {
         let path = FieldPath::parse("world.obstacle").index(*index);

@@ -66,15 +66,24 @@ fn run_settings() {
         finding("time_limit_s", "must be above 0", "0.0")
     );
     assert_eq!(
-        one(&with("time_limit_s = 60.0", "time_limit_s = 60.0\nphysics_rate_hz = -300.0")),
+        one(&with(
+            "time_limit_s = 60.0",
+            "time_limit_s = 60.0\nphysics_rate_hz = -300.0"
+        )),
         finding("physics_rate_hz", "must be above 0", "-300.0")
     );
     // 1e6 s at 300 Hz is 3e8 steps; the limit 1e8 allows 333333.33 s.
     let (path, message, _) = one(&with("time_limit_s = 60.0", "time_limit_s = 1e6"));
     assert_eq!(path, "time_limit_s");
-    assert!(message.starts_with("must be at most 333333.33"), "{message}");
+    assert!(
+        message.starts_with("must be at most 333333.33"),
+        "{message}"
+    );
     assert_eq!(
-        one(&with("time_limit_s = 60.0", "time_limit_s = 60.0\noutputs = { series_rate_hz = 0.0 }")),
+        one(&with(
+            "time_limit_s = 60.0",
+            "time_limit_s = 60.0\noutputs = { series_rate_hz = 0.0 }"
+        )),
         finding("outputs.series_rate_hz", "must be above 0", "0.0")
     );
 }
@@ -88,11 +97,19 @@ fn map_probabilities() {
     );
     assert_eq!(
         one(&map("p_hit = 0.5")),
-        finding("map.p_hit", "must be above 0.5 (a hit must raise the occupancy)", "0.5")
+        finding(
+            "map.p_hit",
+            "must be above 0.5 (a hit must raise the occupancy)",
+            "0.5"
+        )
     );
     assert_eq!(
         one(&map("p_miss = 0.5")),
-        finding("map.p_miss", "must be below 0.5 (a miss must lower the occupancy)", "0.5")
+        finding(
+            "map.p_miss",
+            "must be below 0.5 (a miss must lower the occupancy)",
+            "0.5"
+        )
     );
     assert_eq!(
         one(&map("p_min = 0.0")),
@@ -104,11 +121,19 @@ fn map_probabilities() {
     );
     assert_eq!(
         one(&map("p_min = 0.6")),
-        finding("map.p_min", "must be below 0.5 (else no voxel can ever be free)", "0.6")
+        finding(
+            "map.p_min",
+            "must be below 0.5 (else no voxel can ever be free)",
+            "0.6"
+        )
     );
     assert_eq!(
         one(&map("p_max = 0.4\np_min = 0.1")),
-        finding("map.p_max", "must be at least 0.5 (else no voxel can ever be occupied)", "0.4")
+        finding(
+            "map.p_max",
+            "must be at least 0.5 (else no voxel can ever be occupied)",
+            "0.4"
+        )
     );
 }
 
@@ -141,22 +166,32 @@ fn bounds_and_resolution() {
             "1.0"
         )
     );
-    // 10 x 10 x 3 m at 1 mm: 3e11 voxels; the finest allowed is cbrt(300 / 2e9) = 5.3 mm.
-    let (path, message, found) = one(&map("resolution = 0.001"));
+    // 10 x 10 x 3 m at 2 mm: 5000 x 5000 x 1500 = 3.75e10 voxels; the finest allowed is
+    // cbrt(300 m^3 / 2e9) = 5.3 mm. (The camera's auto grid, 2501 x 1946 rays, stays allowed.)
+    let (path, message, found) = one(&map("resolution = 0.002"));
     assert_eq!(path, "map.resolution");
     assert_eq!(
         message,
-        "must be at least about 0.005 (world.bounds would hold 3.000e11 voxels; the limit is 2e9)"
+        "must be at least about 0.005 (world.bounds would hold 3.750e10 voxels; the limit is 2e9)"
     );
-    assert_eq!(found.as_deref(), Some("0.001"));
+    assert_eq!(found.as_deref(), Some("0.002"));
 }
 
 #[test]
 fn camera_settings() {
-    let camera = |extra: &str| with("kind = \"depth_camera\"", &format!("kind = \"depth_camera\"\n{extra}"));
+    let camera = |extra: &str| {
+        with(
+            "kind = \"depth_camera\"",
+            &format!("kind = \"depth_camera\"\n{extra}"),
+        )
+    };
     assert_eq!(
         one(&camera("range_min = 6.0\nrange_max = 5.0")),
-        finding("uav[0].sensor[0].range_min", "must be below range_max (5.0)", "6.0")
+        finding(
+            "uav[0].sensor[0].range_min",
+            "must be below range_max (5.0)",
+            "6.0"
+        )
     );
     assert_eq!(
         one(&camera("range_min = -0.5")),
@@ -189,20 +224,32 @@ fn camera_settings() {
     let (path, _, found) = one(&camera("ray_grid = [10000, 10000]"));
     assert_eq!(path, "uav[0].sensor[0].ray_grid");
     assert_eq!(found.as_deref(), Some("1.000e8 rays"));
-    // Auto grid at 1 mm voxels and 50 m range: step 2e-5 rad, 50001 x 38962 rays.
-    let fine = with("[world.bounds]", "[map]\nresolution = 0.001\n[world.bounds]")
-        .replace("max = [10.0, 10.0, 3.0]", "max = [1.0, 1.0, 1.0]")
-        .replace("[1.0, 1.0, 1.0] }", "[0.5, 0.5, 0.5] }")
-        .replace("[[5.0, 5.0, 1.0]]", "[[0.5, 0.6, 0.5]]")
-        .replace("kind = \"depth_camera\"", "kind = \"depth_camera\"\nrange_max = 50.0");
+    // Auto grid at 1 mm voxels and 50 m range: step 2e-5 rad; hfov 1.0 rad gives 50001
+    // columns, vfov 2 atan(0.75 tan 0.5) = 0.77773 rad gives 38888 rows: 1.944e9 rays.
+    let fine = with(
+        "[world.bounds]",
+        "[map]\nresolution = 0.001\n[world.bounds]",
+    )
+    .replace("max = [10.0, 10.0, 3.0]", "max = [1.0, 1.0, 1.0]")
+    .replace("[1.0, 1.0, 1.0] }", "[0.5, 0.5, 0.5] }")
+    .replace("[[5.0, 5.0, 1.0]]", "[[0.5, 0.6, 0.5]]")
+    .replace(
+        "kind = \"depth_camera\"",
+        "kind = \"depth_camera\"\nrange_max = 50.0",
+    );
     let (path, _, found) = one(&fine);
     assert_eq!(path, "uav[0].sensor[0].ray_grid");
-    assert_eq!(found.as_deref(), Some("1.948e9 rays"));
+    assert_eq!(found.as_deref(), Some("1.944e9 rays"));
 }
 
 #[test]
 fn sensor_quality() {
-    let camera = |extra: &str| with("kind = \"depth_camera\"", &format!("kind = \"depth_camera\"\n{extra}"));
+    let camera = |extra: &str| {
+        with(
+            "kind = \"depth_camera\"",
+            &format!("kind = \"depth_camera\"\n{extra}"),
+        )
+    };
     assert_eq!(
         one(&camera("quality = { p_hit = 0.4 }")),
         finding(
@@ -213,17 +260,30 @@ fn sensor_quality() {
     );
     assert_eq!(
         one(&camera("quality = { p_miss = 1.5 }")),
-        finding("uav[0].sensor[0].quality.p_miss", "must be a probability in (0, 1)", "1.5")
+        finding(
+            "uav[0].sensor[0].quality.p_miss",
+            "must be a probability in (0, 1)",
+            "1.5"
+        )
     );
     assert_eq!(
         one(&camera("quality = { range_noise_std = -0.01 }")),
-        finding("uav[0].sensor[0].quality.range_noise_std", "must be at least 0", "-0.01")
+        finding(
+            "uav[0].sensor[0].quality.range_noise_std",
+            "must be at least 0",
+            "-0.01"
+        )
     );
 }
 
 #[test]
 fn lidar_settings() {
-    let lidar = |extra: &str| with("kind = \"depth_camera\"", &format!("kind = \"lidar\"\n{extra}"));
+    let lidar = |extra: &str| {
+        with(
+            "kind = \"depth_camera\"",
+            &format!("kind = \"lidar\"\n{extra}"),
+        )
+    };
     assert_eq!(findings(&lidar("hfov = 6.283185307179586")), vec![]);
     assert_eq!(
         one(&lidar("hfov = 6.3")),
@@ -270,7 +330,10 @@ fn uav_settings() {
         finding("uav[0].behaviour.yaw_rate", "must be above 0", "-1.0")
     );
     assert_eq!(
-        one(&with("[[5.0, 5.0, 1.0]]", "[[5.0, 5.0, 1.0], [5.0, 5.0, 4.0]]")),
+        one(&with(
+            "[[5.0, 5.0, 1.0]]",
+            "[[5.0, 5.0, 1.0], [5.0, 5.0, 4.0]]"
+        )),
         finding(
             "uav[0].behaviour.waypoints[1]",
             "must be inside world.bounds ([0.0, 0.0, 0.0] to [10.0, 10.0, 3.0])",
@@ -279,7 +342,11 @@ fn uav_settings() {
     );
     assert_eq!(
         one(&with("[[5.0, 5.0, 1.0]]", "[]")),
-        finding("uav[0].behaviour.waypoints", "must be at least one waypoint", "an empty list")
+        finding(
+            "uav[0].behaviour.waypoints",
+            "must be at least one waypoint",
+            "an empty list"
+        )
     );
     let (path, message, _) = one(&with("name = \"a\"", "name = \"a\"\nairframe = \"irs\""));
     assert_eq!(path, "uav[0].airframe");
@@ -291,7 +358,9 @@ fn uav_settings() {
 
 #[test]
 fn uav_set() {
-    let second = format!("{BASE}\n[[uav]]\nname = \"a\"\nstart = {{ position = [2.0, 2.0, 1.0] }}\nbehaviour = {{ kind = \"scripted\", speed = 1.0, waypoints = [[1.0, 1.0, 1.0]] }}\n");
+    let second = format!(
+        "{BASE}\n[[uav]]\nname = \"a\"\nstart = {{ position = [2.0, 2.0, 1.0] }}\nbehaviour = {{ kind = \"scripted\", speed = 1.0, waypoints = [[1.0, 1.0, 1.0]] }}\n"
+    );
     assert_eq!(
         one(&second),
         finding(
@@ -311,15 +380,21 @@ fn uav_set() {
 fn obstacle_sizes() {
     let obstacle = |body: &str| format!("{BASE}\n[[world.obstacle]]\n{body}\n");
     assert_eq!(
-        one(&obstacle("kind = \"box\"\ncenter = [5.0, 5.0, 1.0]\nsize = [1.0, 0.0, 1.0]")),
+        one(&obstacle(
+            "kind = \"box\"\ncenter = [5.0, 5.0, 1.0]\nsize = [1.0, 0.0, 1.0]"
+        )),
         finding("world.obstacle[0].size[1]", "must be above 0", "0.0")
     );
     assert_eq!(
-        one(&obstacle("kind = \"sphere\"\ncenter = [5.0, 5.0, 1.0]\nradius = -1.0")),
+        one(&obstacle(
+            "kind = \"sphere\"\ncenter = [5.0, 5.0, 1.0]\nradius = -1.0"
+        )),
         finding("world.obstacle[0].radius", "must be above 0", "-1.0")
     );
     assert_eq!(
-        one(&obstacle("kind = \"cylinder\"\nbase = [5.0, 5.0, 0.0]\nradius = 0.5\nheight = 0.0")),
+        one(&obstacle(
+            "kind = \"cylinder\"\nbase = [5.0, 5.0, 0.0]\nradius = 0.5\nheight = 0.0"
+        )),
         finding("world.obstacle[0].height", "must be above 0", "0.0")
     );
     assert_eq!(
@@ -328,7 +403,10 @@ fn obstacle_sizes() {
     );
     let pillars = "kind = \"pillars\"\nregion_min = [0.0, 0.0]\nregion_max = [10.0, 10.0]\n\
                    radius_min = 0.1\nradius_max = 0.2\nheight = 2.0";
-    assert_eq!(findings(&obstacle(&format!("{pillars}\ndensity = 0.1"))), vec![]);
+    assert_eq!(
+        findings(&obstacle(&format!("{pillars}\ndensity = 0.1"))),
+        vec![]
+    );
     assert_eq!(
         one(&obstacle(&format!("{pillars}\ndensity = 2000.0"))),
         finding(
@@ -338,15 +416,26 @@ fn obstacle_sizes() {
         )
     );
     assert_eq!(
-        one(&obstacle(&format!("{}\ndensity = 0.1", pillars.replace("0.2", "0.05")))),
-        finding("world.obstacle[0].radius_max", "must be at least radius_min (0.1)", "0.05")
+        one(&obstacle(&format!(
+            "{}\ndensity = 0.1",
+            pillars.replace("0.2", "0.05")
+        ))),
+        finding(
+            "world.obstacle[0].radius_max",
+            "must be at least radius_min (0.1)",
+            "0.05"
+        )
     );
     assert_eq!(
         one(&obstacle(&format!(
             "{}\ndensity = 0.1",
             pillars.replace("region_max = [10.0, 10.0]", "region_max = [10.0, -1.0]")
         ))),
-        finding("world.obstacle[0].region_max[1]", "must be above region_min[1] (0.0)", "-1.0")
+        finding(
+            "world.obstacle[0].region_max[1]",
+            "must be above region_min[1] (0.0)",
+            "-1.0"
+        )
     );
 }
 
@@ -359,14 +448,25 @@ fn non_finite_numbers_are_reported_once_by_path() {
         all,
         vec![
             finding("uav[0].behaviour.speed", "must be a finite number", "inf"),
-            finding("uav[0].behaviour.waypoints[0][1]", "must be a finite number", "NaN"),
+            finding(
+                "uav[0].behaviour.waypoints[0][1]",
+                "must be a finite number",
+                "NaN"
+            ),
         ]
     );
     // A NaN range triggers no ordering complaint of its own.
-    let camera = with("kind = \"depth_camera\"", "kind = \"depth_camera\"\nrange_min = nan");
+    let camera = with(
+        "kind = \"depth_camera\"",
+        "kind = \"depth_camera\"\nrange_min = nan",
+    );
     assert_eq!(
         one(&camera),
-        finding("uav[0].sensor[0].range_min", "must be a finite number", "NaN")
+        finding(
+            "uav[0].sensor[0].range_min",
+            "must be a finite number",
+            "NaN"
+        )
     );
 }
 

@@ -19,18 +19,14 @@ pub(crate) struct Context {
 }
 
 impl Context {
-    pub fn of(root: Option<&Scenario>) -> Self {
-        let Some(root) = root else {
-            return Self::default();
-        };
-        let bounds = root.world.bounds;
-        let bounds_ok = (0..3).all(|k| {
-            bounds.min[k].is_finite() && bounds.max[k].is_finite() && bounds.min[k] < bounds.max[k]
+    pub fn of(map: Option<&MapSpec>, bounds: Option<&BoundsSpec>) -> Self {
+        let bounds = bounds.filter(|b| {
+            (0..3).all(|k| b.min[k].is_finite() && b.max[k].is_finite() && b.min[k] < b.max[k])
         });
-        let resolution = root.map.resolution;
+        let map = map.filter(|m| m.resolution.is_finite() && m.resolution > 0.0);
         Self {
-            bounds: bounds_ok.then_some(bounds),
-            map: (resolution.is_finite() && resolution > 0.0).then(|| root.map.clone()),
+            bounds: bounds.copied(),
+            map: map.cloned(),
         }
     }
 }

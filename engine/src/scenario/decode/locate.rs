@@ -1,0 +1,212 @@
+//! Narrowing a decoding error down to the value it is about.
+
+use serde::de::DeserializeOwned;
+
+use super::try_decode;
+use crate::scenario::de::{DeError, DeErrorKind};
+use crate::scenario::path::{FieldPath, Segment};
+use crate::scenario::tree::Node;
+
+/// Trial decodings spent locating one problem (see `blame`); a bisection needs about
+/// log2(values) per level, so this is only reached by absurd files.
+const MAX_BLAME_TRIALS: usize = 256;
+
+/// Narrows an error down to the value it is about. Errors from serde's buffered content
+/// (internally tagged enums) only name the enum's table.
+pub(super) fn locate<T: DeserializeOwned>(
+    node: &Node,
+    root: &FieldPath,
+    at: &FieldPath,
+    error: &DeError,
+) -> FieldPath {
+    let Some(target) = at.strip_prefix(root).and_then(|rel| node.get(rel)) else {
+        return at.clone();
+    };
+    match &error.kind {
+        DeErrorKind::UnknownField { field, expected } => {
+            if at.last_key() == Some(field.as_str()) {
+                return at.clone();
+            }
+            find_unknown_key(target, at, field, expected).unwrap_or_else(|| at.clone())
+        }
+        DeErrorKind::UnknownVariant { .. } => {
+            if at.last_key() != Some("kind") && target.get(&[key("kind")]).is_some() {
+                at.key("kind")
+            } else {
+                at.clone()
+            }
+        }
+        _ if target.is_container() => blame::<T>(node, root, at, error),
+        _ => at.clone(),
+    }
+}
+
+fn key(name: &str) -> Segment {
+    Segment::Key(name.to_owned())
+}
+
+/// The table inside `target` (found at `at`) holding the unknown key `field`; when several do,
+/// the one whose other keys best fit the valid names, then the shallowest.
+fn find_unknown_key(
+    target: &Node,
+    at: &FieldPath,
+    field: &str,
+    expected: &[&str],
+) -> Option<FieldPath> {
+    let mut best: Option<(usize, usize, FieldPath)> = None;
+    target.walk(at, &mut |path, node| {
+        let keys = node.keys();
+        if !keys.contains(&field) {
+            return;
+        }
+        let fit = keys.iter().filter(|k| expected.contains(k)).count();
+        let depth = path.segments().len();
+        let better = best.as_ref().is_none_or(|(best_fit, best_depth, _)| {
+            (fit, usize::MAX - depth) > (*best_fit, usize::MAX - best_depth)
+        });
+        if better {
+            best = Some((fit, depth, path.key(field)));
+        }
+    });
+    best.map(|(_, _, path)| path)
+}
+
+/// The value inside `target` (found at `at`) the error is about. serde decodes a table's or an
+/// array's values in order and stops at the first bad one, so keeping only the first `n`
+/// values of a level reproduces the problem exactly when the culprit is among them: the
+/// smallest such `n` (found by bisection) names the value to descend into. The search stops at
+/// a level that reproduces the problem with none of its values (the level itself is wrong, such
+/// as an array where a table belongs) or that has no values. A `kind` tag that is a string is
+/// always kept, since dropping it changes every error. Trial decodings are bounded, so a huge
+/// entry cannot make the loader hang; past the bound the error stays where the search got to.
+fn blame<T: DeserializeOwned>(
+    node: &Node,
+    root: &FieldPath,
+    at: &FieldPath,
+    error: &DeError,
+) -> FieldPath {
+    let mut current = at.clone();
+    let mut trials = 0;
+    loop {
+        let Some(relative) = current.strip_prefix(root) else {
+            return current;
+        };
+        let Some(level) = node.get(relative) else {
+            return current;
+        };
+        let count = level.children(&current).len();
+        let reproduces = |keep: usize| {
+            let mut trial = node.clone();
+            if let Some(level) = trial.get_mut(relative) {
+                level.keep_first(keep);
+            }
+            matches!(try_decode::<T>(&trial, root), Err(again) if same_problem(&again, error))
+        };
+        trials += 1;
+        if count == 0 || reproduces(0) {
+            return current;
+        }
+        // The problem shows with all `count` values and not with none: bisect for the first
+        // value that brings it in.
+        let (mut without, mut with) = (0, count);
+        while with - without > 1 {
+            trials += 1;
+            if trials > MAX_BLAME_TRIALS {
+                return current;
+            }
+            let middle = without + (with - without) / 2;
+            if reproduces(middle) {
+                with = middle;
+            } else {
+                without = middle;
+            }
+        }
+        let Some((culprit, _)) = level.children(&current).into_iter().nth(with - 1) else {
+            return current;
+        };
+        current = culprit;
+    }
+}
+
+/// Whether two errors are the same problem: same place, kind and expectation. What was found
+/// is left out, since cutting a value out of an array changes its length and not its fault
+/// (`[1.0, 2.0]` for a point stays "not 3 numbers" when its first number is cut).
+fn same_problem(a: &DeError, b: &DeError) -> bool {
+    use DeErrorKind as K;
+    a.path == b.path
+        && match (&a.kind, &b.kind) {
+            (K::InvalidType { expected: x, .. }, K::InvalidType { expected: y, .. })
+            | (K::InvalidValue { expected: x, .. }, K::InvalidValue { expected: y, .. })
+            | (K::InvalidLength { expected: x, .. }, K::InvalidLength { expected: y, .. }) => {
+                x == y
+            }
+            (x, y) => x == y,
+        }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::schema::SensorSpec;
+    use crate::scenario::tree::parse_document;
+
+    /// The path an error of a sensor table is narrowed down to.
+    fn culprit(text: &str) -> String {
+        let root = FieldPath::parse("uav[0].sensor[0]");
+        let tree = parse_document(text).unwrap();
+        let error = try_decode::<SensorSpec>(&tree, &root).unwrap_err();
+        let at = error.path.clone().unwrap();
+        // Inside the `kind` table serde only knows the table.
+        assert_eq!(at, root);
+        locate::<SensorSpec>(&tree, &root, &at, &error).to_string()
+    }
+
+    #[test]
+    fn errors_inside_kind_tables_are_narrowed_to_their_value() {
+        let sensor = "kind = \"depth_camera\"\nwidth = 640\n";
+        assert_eq!(
+            culprit(&format!("{sensor}range_max = \"far\"\nrate_hz = 30.0\n")),
+            "uav[0].sensor[0].range_max"
+        );
+        // A table where a string or an array belongs: the table, not a value inside it.
+        assert_eq!(
+            culprit(&format!("{sensor}ray_grid = {{ columns = 64 }}\n")),
+            "uav[0].sensor[0].ray_grid"
+        );
+        // serde takes a struct from an array of its fields in order, so inside a `kind` table
+        // `mount = [1, 2]` is read as translation = 1 (not 3 numbers): its first element.
+        assert_eq!(
+            culprit(&format!("{sensor}mount = [1, 2]\n")),
+            "uav[0].sensor[0].mount[0]"
+        );
+        // A nested value: down to the element.
+        assert_eq!(
+            culprit(&format!("{sensor}mount = {{ rpy = [0.0, \"up\", 0.0] }}\n")),
+            "uav[0].sensor[0].mount.rpy[1]"
+        );
+        // Unknown fields are found by name, in the table that holds them.
+        assert_eq!(
+            culprit(&format!(
+                "{sensor}mount = {{ rpy = [0, 0, 0], shift = 1 }}\n"
+            )),
+            "uav[0].sensor[0].mount.shift"
+        );
+        // A tag that is no string is the culprit itself.
+        assert_eq!(culprit("width = 640\nkind = 3\n"), "uav[0].sensor[0].kind");
+    }
+
+    #[test]
+    fn a_shorter_array_is_the_same_problem() {
+        let error = |len| DeError {
+            kind: DeErrorKind::InvalidLength {
+                len,
+                expected: "an array of length 3".into(),
+            },
+            path: Some(FieldPath::parse("b")),
+        };
+        assert!(same_problem(&error(2), &error(1)));
+        let mut elsewhere = error(2);
+        elsewhere.path = Some(FieldPath::parse("c"));
+        assert!(!same_problem(&error(2), &elsewhere));
+    }
+}

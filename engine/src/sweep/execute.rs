@@ -1,0 +1,277 @@
+//! Running a plan: runs in parallel on a rayon pool, each into its own folder, resumable and
+//! robust to failing runs (DESIGN.md, "Runs, sweeps and scale").
+//!
+//! Layout of a results folder:
+//! ```text
+//! DIR/plan.toml              the plan as written (the record of what was asked)
+//! DIR/runs/<run id>/run.json the run's coordinates, written before it starts
+//! DIR/runs/<run id>/...      the run's files (series.csv, uavs.csv, maps)
+//! DIR/runs/<run id>/summary.json   written last: its presence marks a finished run
+//! ```
+//! A run is finished when its `summary.json` exists, whatever its outcome: running the plan
+//! again into the same folder skips it. A folder without `summary.json` is what an
+//! interrupted run left; it is cleared and the run starts over.
+
+use super::apply::apply_overrides;
+use super::expand::{RunSpec, Shard, expand};
+use super::plan::Plan;
+use crate::output::write_atomically;
+use crate::run::{RunOptions, run as run_scenario};
+use crate::scenario::parse_str;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::panic::{AssertUnwindSafe, catch_unwind};
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::time::Duration;
+use thiserror::Error;
+use uavex_components::sim::Outcome;
+
+/// File whose presence marks a finished run.
+pub const SUMMARY_FILE: &str = "summary.json";
+/// A run's coordinates in its folder.
+pub const RUN_FILE: &str = "run.json";
+/// Sub-folder of a results folder that holds one folder per run.
+pub const RUNS_DIR: &str = "runs";
+/// The plan's copy in a results folder.
+pub const PLAN_FILE: &str = "plan.toml";
+
+/// How to run a plan.
+#[derive(Debug, Clone)]
+pub struct SweepOptions {
+    pub out_dir: PathBuf,
+    /// Runs at once (threads of the pool); at least 1.
+    pub jobs: usize,
+    /// Run only this part of the plan.
+    pub shard: Option<Shard>,
+    /// Start at most this many runs now (in plan order), leaving the rest for a later resume.
+    pub max_runs: Option<usize>,
+    /// Draw a progress bar on stderr (only when stderr is a terminal).
+    pub progress: bool,
+}
+
+impl SweepOptions {
+    pub fn new(out_dir: impl Into<PathBuf>) -> Self {
+        Self {
+            out_dir: out_dir.into(),
+            jobs: std::thread::available_parallelism().map_or(1, |n| n.get()),
+            shard: None,
+            max_runs: None,
+            progress: false,
+        }
+    }
+}
+
+/// What a sweep did.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct SweepReport {
+    /// Runs of the plan (of this shard).
+    pub planned: usize,
+    /// Runs skipped because they had finished before.
+    pub already_done: usize,
+    /// Runs run now.
+    pub ran: usize,
+    /// Runs run now that failed (id, reason), in plan order.
+    pub failed: Vec<(String, String)>,
+    /// Runs left for later by `max_runs`.
+    pub not_started: usize,
+}
+
+/// A sweep that cannot start or whose results cannot be written at all.
+#[derive(Debug, Error)]
+pub enum SweepError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("cannot start the worker threads: {0}")]
+    Pool(String),
+    #[error("{0} and {1} hold results of different plans (their plan.toml differ)")]
+    PlansDiffer(PathBuf, PathBuf),
+    #[error(transparent)]
+    Plan(#[from] super::plan::PlanError),
+}
+
+pub(super) fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
+    move |source| SweepError::Io {
+        path: path.to_owned(),
+        source,
+    }
+}
+
+/// The summary of a run that never started (its scenario was refused) or whose results could
+/// not be written: only what is known, so tables show its metrics as missing, not as zeros.
+#[derive(Debug, Serialize)]
+struct FailedSummary<'a> {
+    scenario: &'a str,
+    seed: u64,
+    outcome: Outcome,
+    reason: &'a str,
+}
+
+/// Runs `plan` (or its shard) into `options.out_dir`, skipping runs finished before.
+pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, SweepError> {
+    let runs_dir = options.out_dir.join(RUNS_DIR);
+    std::fs::create_dir_all(&runs_dir).map_err(io_error(&runs_dir))?;
+    let plan_copy = options.out_dir.join(PLAN_FILE);
+    write_atomically(&plan_copy, plan.text.as_bytes()).map_err(io_error(&plan_copy))?;
+
+    let mine: Vec<RunSpec> = expand(plan)
+        .into_iter()
+        .filter(|run| options.shard.is_none_or(|shard| shard.contains(run.index)))
+        .collect();
+    let mut report = SweepReport {
+        planned: mine.len(),
+        ..SweepReport::default()
+    };
+    let mut todo: Vec<&RunSpec> = mine
+        .iter()
+        .filter(|run| !is_finished(&runs_dir.join(&run.id)))
+        .collect();
+    report.already_done = mine.len() - todo.len();
+    if let Some(max) = options.max_runs
+        && todo.len() > max
+    {
+        report.not_started = todo.len() - max;
+        todo.truncate(max);
+    }
+    if todo.is_empty() {
+        return Ok(report);
+    }
+
+    // Each scenario file is read once; a file that cannot be read fails its runs.
+    let texts: BTreeMap<&Path, Result<String, String>> = todo
+        .iter()
+        .map(|run| {
+            let text = std::fs::read_to_string(&run.scenario_file).map_err(|e| {
+                format!(
+                    "cannot read the scenario {}: {e}",
+                    run.scenario_file.display()
+                )
+            });
+            (run.scenario_file.as_path(), text)
+        })
+        .collect();
+
+    let bar = progress_bar(todo.len(), options.progress);
+    let failed = Mutex::new(Vec::new());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(options.jobs.max(1))
+        .build()
+        .map_err(|e| SweepError::Pool(e.to_string()))?;
+    pool.install(|| {
+        todo.par_iter().for_each(|run| {
+            let text = &texts[run.scenario_file.as_path()];
+            let dir = runs_dir.join(&run.id);
+            let ending = execute_run(run, text, &dir);
+            if let Err(reason) = &ending {
+                let first_line = reason.lines().next().unwrap_or_default();
+                bar.println(format!("run {} failed: {first_line}", run.id));
+                let mut failed = failed.lock().unwrap_or_else(|e| e.into_inner());
+                failed.push((run.index, run.id.clone(), reason.clone()));
+                bar.set_message(format!("{} failed", failed.len()));
+            }
+            bar.inc(1);
+        });
+    });
+    bar.finish();
+
+    let mut failed = failed.into_inner().unwrap_or_else(|e| e.into_inner());
+    failed.sort();
+    report.ran = todo.len();
+    report.failed = failed.into_iter().map(|(_, id, why)| (id, why)).collect();
+    Ok(report)
+}
+
+/// True when the run in `dir` has finished (its summary exists).
+pub fn is_finished(dir: &Path) -> bool {
+    dir.join(SUMMARY_FILE).is_file()
+}
+
+/// Runs one run into `dir`; `Err(reason)` when it failed (and its failed summary is written).
+fn execute_run(run: &RunSpec, text: &Result<String, String>, dir: &Path) -> Result<(), String> {
+    let attempt = catch_unwind(AssertUnwindSafe(|| attempt_run(run, text, dir)));
+    let outcome = attempt.unwrap_or_else(|panic| {
+        let message = panic
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| panic.downcast_ref::<&str>().copied())
+            .unwrap_or("unknown panic");
+        Err(format!("the run panicked: {message}"))
+    });
+    match outcome {
+        Ok(Some(reason)) => Err(reason),
+        Ok(None) => Ok(()),
+        Err(reason) => {
+            let summary = FailedSummary {
+                scenario: &run.scene,
+                seed: run.seed,
+                outcome: Outcome::Failed,
+                reason: &reason,
+            };
+            let written = serde_json::to_vec_pretty(&summary)
+                .map_err(std::io::Error::other)
+                .and_then(|json| {
+                    std::fs::create_dir_all(dir)?;
+                    write_atomically(&dir.join(SUMMARY_FILE), &json)
+                });
+            match written {
+                Ok(()) => Err(reason),
+                Err(e) => Err(format!("{reason} (and its summary could not be written: {e})")),
+            }
+        }
+    }
+}
+
+/// `Ok(None)`: finished well; `Ok(Some(reason))`: ran and failed, summary written by the run;
+/// `Err(reason)`: did not run or its summary was not written.
+fn attempt_run(
+    run: &RunSpec,
+    text: &Result<String, String>,
+    dir: &Path,
+) -> Result<Option<String>, String> {
+    // Clear what an interrupted attempt left.
+    if dir.exists() {
+        std::fs::remove_dir_all(dir)
+            .map_err(|e| format!("cannot clear {} for a new attempt: {e}", dir.display()))?;
+    }
+    std::fs::create_dir_all(dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
+    let json = serde_json::to_vec_pretty(&run.record()).map_err(|e| e.to_string())?;
+    write_atomically(&dir.join(RUN_FILE), &json)
+        .map_err(|e| format!("cannot write {}: {e}", dir.join(RUN_FILE).display()))?;
+
+    let text = text.as_ref().map_err(Clone::clone)?;
+    let edited = apply_overrides(text, &run.overrides).map_err(|e| e.to_string())?;
+    let loaded = parse_str(&edited, &run.scenario_file)
+        .map_err(|errors| format!("the scenario was refused:\n{errors}"))?;
+    let options = RunOptions {
+        out_dir: Some(dir.to_owned()),
+        seed: Some(run.seed),
+    };
+    let summary =
+        run_scenario(&loaded, &options).map_err(|errors| format!("the world was refused:\n{errors}"))?;
+    if !is_finished(dir) {
+        return Err(summary.reason);
+    }
+    Ok((summary.outcome == Outcome::Failed).then_some(summary.reason))
+}
+
+fn progress_bar(len: usize, show: bool) -> ProgressBar {
+    if !show {
+        return ProgressBar::hidden();
+    }
+    let bar = ProgressBar::new(len as u64);
+    let style = ProgressStyle::with_template(
+        "{elapsed_precise} [{bar:32}] {pos}/{len} runs, {msg} (ETA {eta})",
+    )
+    .map(|s| s.progress_chars("=> "))
+    .unwrap_or_else(|_| ProgressStyle::default_bar());
+    bar.set_style(style);
+    bar.set_message("0 failed");
+    bar.enable_steady_tick(Duration::from_millis(500));
+    bar
+}
+

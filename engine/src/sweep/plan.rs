@@ -1,0 +1,375 @@
+//! Sweep plans: which scenarios, which overrides and which seeds (TOML).
+//!
+//! ```toml
+//! name = "speeds"                       # optional; the plan file's stem by default
+//! seeds = 5                             # seeds 0..5, or a list: seeds = [1, 7, 9]
+//!
+//! [[scenario]]
+//! file = "pillars_scripted.toml"        # relative to this plan file
+//! name = "pillars"                      # optional label; the file stem by default
+//!
+//! [set]                                 # fixed overrides, applied to every run
+//! "outputs.export_map" = false
+//!
+//! [grid]                                # one run per combination of these values
+//! "uav.0.behaviour.speed" = [1.0, 1.5]
+//! "uav.0.behaviour.strategy" = ["eaae", "classic", "nearest"]
+//! ```
+//!
+//! Keys of `[set]` and `[grid]` are field paths of the scenario (`uav.0.behaviour.speed` or
+//! `uav[0].behaviour.speed`). Tables nest: `[grid.uav.0.behaviour]` with `speed = [...]` names
+//! the same path. A grid value is always a list of values, and each element, whatever its type
+//! (a number, a string, a whole table), replaces the value at the path. Grid paths are taken in
+//! alphabetical order (TOML tables do not keep their order); the run set does not depend on it.
+
+use super::apply::Override;
+use super::path::{OverridePath, Step};
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// A plan that parsed and makes sense.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    pub name: String,
+    /// The folder scenario files are resolved against (the plan file's folder).
+    pub base_dir: PathBuf,
+    pub scenarios: Vec<PlanScenario>,
+    /// Overrides applied to every run, before the grid's.
+    pub set: Vec<Override>,
+    /// The varied paths, each with its values.
+    pub grid: Vec<Axis>,
+    pub seeds: Vec<u64>,
+    /// The plan file as written; kept with the results as their record.
+    pub text: String,
+}
+
+/// One scenario of a plan.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PlanScenario {
+    /// The label of the scenario in run names and tables (the `scene` column).
+    pub name: String,
+    /// The file as the plan writes it.
+    pub file: PathBuf,
+}
+
+/// One varied path and the values it takes.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Axis {
+    pub path: OverridePath,
+    pub values: Vec<toml::Value>,
+}
+
+/// Why a plan is refused.
+#[derive(Debug, Error)]
+pub enum PlanError {
+    #[error("cannot read the plan {path}: {source}")]
+    Read {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Invalid { path: PathBuf, message: String },
+}
+
+/// The plan file's shape, before its meaning is checked.
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct PlanFile {
+    name: Option<String>,
+    #[serde(rename = "scenario", default)]
+    scenarios: Vec<ScenarioEntry>,
+    seeds: Option<toml::Value>,
+    #[serde(default)]
+    set: toml::Table,
+    #[serde(default)]
+    grid: toml::Table,
+}
+
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ScenarioEntry {
+    file: PathBuf,
+    name: Option<String>,
+}
+
+impl Plan {
+    /// Reads and checks the plan file at `path`.
+    pub fn load(path: &Path) -> Result<Self, PlanError> {
+        let text = std::fs::read_to_string(path).map_err(|source| PlanError::Read {
+            path: path.to_owned(),
+            source,
+        })?;
+        Self::parse(&text, path)
+    }
+
+    /// Checks plan `text`; `path` names it in messages and gives the base folder and the
+    /// default name.
+    pub fn parse(text: &str, path: &Path) -> Result<Self, PlanError> {
+        let invalid = |message: String| PlanError::Invalid {
+            path: path.to_owned(),
+            message,
+        };
+        let file: PlanFile =
+            toml::from_str(text).map_err(|e| invalid(e.to_string().trim_end().to_owned()))?;
+        let stem = |p: &Path| {
+            p.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        };
+        let name = file.name.unwrap_or_else(|| stem(path));
+
+        if file.scenarios.is_empty() {
+            return Err(invalid(
+                "the plan names no scenario: add a [[scenario]] with a `file`".to_owned(),
+            ));
+        }
+        let mut scenarios = Vec::new();
+        let mut labels = BTreeSet::new();
+        for entry in file.scenarios {
+            let label = entry.name.unwrap_or_else(|| stem(&entry.file));
+            if label.is_empty() {
+                return Err(invalid("a [[scenario]] has an empty name".to_owned()));
+            }
+            if !labels.insert(label.clone()) {
+                return Err(invalid(format!(
+                    "two scenarios are named `{label}`: give one a different `name`"
+                )));
+            }
+            scenarios.push(PlanScenario {
+                name: label,
+                file: entry.file,
+            });
+        }
+
+        let seeds = seeds(file.seeds).map_err(invalid)?;
+
+        let mut set = Vec::new();
+        flatten(&file.set, &OverridePath::from_steps(&[]), &mut |path, value| {
+            set.push(Override {
+                path,
+                value: value.clone(),
+            });
+            Ok(())
+        })
+        .map_err(|e| invalid(format!("[set]: {e}")))?;
+
+        let mut grid = Vec::new();
+        flatten(&file.grid, &OverridePath::from_steps(&[]), &mut |path, value| {
+            let toml::Value::Array(values) = value else {
+                return Err(format!(
+                    "`{path}` must be a list of the values to try, e.g. `[{value}]`"
+                ));
+            };
+            if values.is_empty() {
+                return Err(format!("`{path}` has no value to try"));
+            }
+            let mut seen = BTreeSet::new();
+            for v in values {
+                if !seen.insert(v.to_string()) {
+                    return Err(format!("`{path}` lists {v} twice"));
+                }
+            }
+            grid.push(Axis {
+                path,
+                values: values.clone(),
+            });
+            Ok(())
+        })
+        .map_err(|e| invalid(format!("[grid]: {e}")))?;
+        let mut paths = BTreeSet::new();
+        for axis in &grid {
+            if !paths.insert(axis.path.clone()) {
+                return Err(invalid(format!(
+                    "[grid]: `{}` is written twice (once dotted, once nested?)",
+                    axis.path
+                )));
+            }
+        }
+
+        let base_dir = match path.parent() {
+            Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
+            _ => PathBuf::from("."),
+        };
+        Ok(Self {
+            name,
+            base_dir,
+            scenarios,
+            set,
+            grid,
+            seeds,
+            text: text.to_owned(),
+        })
+    }
+
+    /// How many runs the whole plan has.
+    pub fn run_count(&self) -> usize {
+        self.scenarios.len()
+            * self.grid.iter().map(|a| a.values.len()).product::<usize>()
+            * self.seeds.len()
+    }
+}
+
+/// `seeds = N` (seeds 0..N) or `seeds = [..]` (distinct, non-negative).
+fn seeds(value: Option<toml::Value>) -> Result<Vec<u64>, String> {
+    let expected = "`seeds` must be a count (seeds = 5 runs seeds 0 to 4) or a list of seeds";
+    let seed = |v: &toml::Value| {
+        v.as_integer()
+            .and_then(|i| u64::try_from(i).ok())
+            .ok_or_else(|| format!("{expected}; a seed is a whole number >= 0, not {v}"))
+    };
+    let list = match value {
+        None => return Err(format!("the plan has no seeds: {expected}")),
+        Some(toml::Value::Array(items)) => items.iter().map(seed).collect::<Result<Vec<_>, _>>()?,
+        Some(count @ toml::Value::Integer(_)) => (0..seed(&count)?).collect(),
+        Some(other) => return Err(format!("{expected}, not {other}")),
+    };
+    if list.is_empty() {
+        return Err(format!("the plan runs no seed: {expected}"));
+    }
+    let distinct: BTreeSet<u64> = list.iter().copied().collect();
+    if distinct.len() != list.len() {
+        return Err("`seeds` lists a seed twice".to_owned());
+    }
+    Ok(list)
+}
+
+/// Calls `leaf` with every non-table value of `table` and its full path; keys are paths
+/// themselves (`"uav.0.speed"`), and nested tables extend them.
+fn flatten(
+    table: &toml::Table,
+    prefix: &OverridePath,
+    leaf: &mut dyn FnMut(OverridePath, &toml::Value) -> Result<(), String>,
+) -> Result<(), String> {
+    for (key, value) in table {
+        let path = prefix.join(&OverridePath::parse(key).map_err(|e| e.to_string())?);
+        if let Some(first) = path.steps().first()
+            && matches!(first, Step::Index(_))
+        {
+            return Err(format!("`{path}` starts with a list index"));
+        }
+        match value {
+            toml::Value::Table(inner) => flatten(inner, &path, leaf)?,
+            other => leaf(path, other)?,
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Plan, String> {
+        Plan::parse(text, Path::new("plans/speeds.toml")).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn reads_scenarios_set_grid_and_seed_count() {
+        let plan = parse(
+            r#"
+            seeds = 3
+            [[scenario]]
+            file = "../scenarios/pillars_scripted.toml"
+            [[scenario]]
+            file = "room.toml"
+            name = "room"
+            [set]
+            "outputs.export_map" = false
+            [grid]
+            "uav.0.behaviour.speed" = [1.0, 1.5]
+            map = { resolution = [0.1, 0.2] }
+            "#,
+        )
+        .unwrap();
+        assert_eq!(plan.name, "speeds");
+        assert_eq!(plan.base_dir, Path::new("plans"));
+        let names: Vec<&str> = plan.scenarios.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(names, ["pillars_scripted", "room"]);
+        assert_eq!(plan.seeds, [0, 1, 2]);
+        assert_eq!(plan.set.len(), 1);
+        assert_eq!(plan.set[0].path.to_string(), "outputs.export_map");
+        assert_eq!(plan.set[0].value, toml::Value::Boolean(false));
+        let axes: Vec<(String, usize)> = plan
+            .grid
+            .iter()
+            .map(|a| (a.path.to_string(), a.values.len()))
+            .collect();
+        // Alphabetical: `map` before `uav.0...`.
+        assert_eq!(
+            axes,
+            [
+                ("map.resolution".to_owned(), 2),
+                ("uav.0.behaviour.speed".to_owned(), 2)
+            ]
+        );
+        assert_eq!(plan.run_count(), 2 * 2 * 2 * 3);
+    }
+
+    #[test]
+    fn seed_lists_and_whole_table_values() {
+        let plan = parse(
+            r#"
+            seeds = [7, 3]
+            [[scenario]]
+            file = "a.toml"
+            [grid]
+            "uav[0].behaviour" = [{ kind = "scripted", speed = 1.0, waypoints = [] }]
+            "#,
+        )
+        .unwrap();
+        assert_eq!(plan.seeds, [7, 3]);
+        assert_eq!(plan.grid[0].path.to_string(), "uav.0.behaviour");
+        assert!(plan.grid[0].values[0].is_table());
+        assert_eq!(plan.run_count(), 2);
+    }
+
+    #[test]
+    fn refusals_say_what_is_wrong() {
+        let cases = [
+            ("seeds = 2", "names no scenario"),
+            ("[[scenario]]\nfile = \"a.toml\"", "has no seeds"),
+            ("seeds = -1\n[[scenario]]\nfile = \"a.toml\"", "not -1"),
+            ("seeds = [1, 1]\n[[scenario]]\nfile = \"a.toml\"", "twice"),
+            ("seeds = 0\n[[scenario]]\nfile = \"a.toml\"", "runs no seed"),
+            (
+                "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[[scenario]]\nfile = \"x/a.toml\"",
+                "two scenarios are named `a`",
+            ),
+            (
+                "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n\"uav.0.speed\" = 2.0",
+                "must be a list of the values to try, e.g. `[2.0]`",
+            ),
+            (
+                "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n\"x\" = []",
+                "`x` has no value to try",
+            ),
+            (
+                "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n\"x\" = [1, 1]",
+                "`x` lists 1 twice",
+            ),
+            (
+                "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n\"a[\" = [1]",
+                "is not a field path",
+            ),
+            ("seeds = 1\nscenarios = []", "unknown field `scenarios`"),
+        ];
+        for (text, expected) in cases {
+            let error = parse(text).expect_err(text);
+            assert!(
+                error.starts_with("plans/speeds.toml: ") && error.contains(expected),
+                "{text:?}: {error}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_same_path_twice_is_refused() {
+        let error = parse(
+            "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n\"map.resolution\" = [1]\n\
+             map = { resolution = [2] }",
+        )
+        .unwrap_err();
+        assert!(error.contains("`map.resolution` is written twice"), "{error}");
+    }
+}

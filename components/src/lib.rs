@@ -2,9 +2,11 @@
 //!
 //! Nothing here has behaviour beyond small accessors; algorithms live in `uavex-systems`.
 
+pub mod airframe;
 pub mod map;
 pub mod sensor;
 pub mod sim;
+pub mod trajectory;
 pub mod uav;
 pub mod world;
 

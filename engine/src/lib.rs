@@ -3,8 +3,10 @@
 pub mod formats;
 pub mod metrics;
 pub mod output;
+pub mod physics;
 pub mod run;
 pub mod scenario;
 pub mod sim;
 pub mod sweep;
+pub mod tables;
 pub mod world;

@@ -2,6 +2,8 @@
 //! functions over plain data (unit-tested without a World) and the thin ECS systems that apply
 //! them.
 pub mod behaviour;
+pub mod flight;
 pub mod mapping;
 pub mod sensing;
 pub mod stages;
+pub mod trajectory;

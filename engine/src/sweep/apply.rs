@@ -240,8 +240,8 @@ waypoints = [[3.0, 2.0, 1.0], [2.0, 2.0, 1.0]]
         let changed: Vec<usize> = (0..lines.len())
             .filter(|&i| lines[i] != original[i])
             .collect();
-        assert_eq!(changed, vec![19], "only the speed line differs:\n{text}");
-        assert_eq!(lines[19].replace(' ', ""), "speed=0.75");
+        assert_eq!(changed, vec![18], "only the speed line differs:\n{text}");
+        assert_eq!(lines[18].replace(' ', ""), "speed=0.75");
     }
 
     #[test]
@@ -252,14 +252,23 @@ waypoints = [[3.0, 2.0, 1.0], [2.0, 2.0, 1.0]]
                 "uav.0.behaviour",
                 r#"{ kind = "scripted", speed = 3.0, waypoints = [] }"#,
             ),
-            o("uav.1", r#"{ name = "c", start = { position = [1.0, 2.0, 1.0] } }"#),
+            o(
+                "uav.1",
+                r#"{ name = "c", start = { position = [1.0, 2.0, 1.0] } }"#,
+            ),
         ]);
         assert_eq!(t["map"]["resolution"].as_float(), Some(0.2));
         let uav = t["uav"].as_array().unwrap();
         assert_eq!(uav[0]["behaviour"]["speed"].as_float(), Some(3.0));
-        assert_eq!(uav[0]["behaviour"]["waypoints"].as_array().unwrap().len(), 0);
+        assert_eq!(
+            uav[0]["behaviour"]["waypoints"].as_array().unwrap().len(),
+            0
+        );
         assert_eq!(uav[1]["name"].as_str(), Some("c"));
-        assert!(uav[1].get("behaviour").is_none(), "the element was replaced whole");
+        assert!(
+            uav[1].get("behaviour").is_none(),
+            "the element was replaced whole"
+        );
     }
 
     #[test]
@@ -270,7 +279,11 @@ waypoints = [[3.0, 2.0, 1.0], [2.0, 2.0, 1.0]]
 
     #[test]
     fn impossible_places_are_explained() {
-        let why = |path: &str, value: &str| apply_overrides(SCENARIO, &[o(path, value)]).unwrap_err().to_string();
+        let why = |path: &str, value: &str| {
+            apply_overrides(SCENARIO, &[o(path, value)])
+                .unwrap_err()
+                .to_string()
+        };
         assert_eq!(
             why("uav.2.name", "\"x\""),
             "override `uav.2.name`: at `uav`: index 2 is out of range: the list has 2 element(s)"

@@ -220,7 +220,9 @@ fn execute_run(run: &RunSpec, text: &Result<String, String>, dir: &Path) -> Resu
                 });
             match written {
                 Ok(()) => Err(reason),
-                Err(e) => Err(format!("{reason} (and its summary could not be written: {e})")),
+                Err(e) => Err(format!(
+                    "{reason} (and its summary could not be written: {e})"
+                )),
             }
         }
     }
@@ -251,8 +253,8 @@ fn attempt_run(
         out_dir: Some(dir.to_owned()),
         seed: Some(run.seed),
     };
-    let summary =
-        run_scenario(&loaded, &options).map_err(|errors| format!("the world was refused:\n{errors}"))?;
+    let summary = run_scenario(&loaded, &options)
+        .map_err(|errors| format!("the world was refused:\n{errors}"))?;
     if !is_finished(dir) {
         return Err(summary.reason);
     }
@@ -274,4 +276,3 @@ fn progress_bar(len: usize, show: bool) -> ProgressBar {
     bar.enable_steady_tick(Duration::from_millis(500));
     bar
 }
-

@@ -84,12 +84,15 @@ pub fn expand(plan: &Plan) -> Vec<RunSpec> {
                     .map(|(axis, value)| (axis.path.to_string(), (*value).clone()))
                     .collect();
                 let mut overrides = plan.set.clone();
-                overrides.extend(plan.grid.iter().zip(combination).map(|(axis, value)| {
-                    Override {
-                        path: axis.path.clone(),
-                        value: (*value).clone(),
-                    }
-                }));
+                overrides.extend(
+                    plan.grid
+                        .iter()
+                        .zip(combination)
+                        .map(|(axis, value)| Override {
+                            path: axis.path.clone(),
+                            value: (*value).clone(),
+                        }),
+                );
                 runs.push(RunSpec {
                     index: runs.len(),
                     id: run_id(&scenario.name, &plan.set, &coordinates, seed),
@@ -275,10 +278,18 @@ mod tests {
         assert_eq!(runs[8].scenario_file, Path::new("dir/b.toml"));
         assert!(runs.iter().enumerate().all(|(i, r)| r.index == i));
         // Fixed overrides first, then the grid's.
-        let paths: Vec<String> = runs[0].overrides.iter().map(|o| o.path.to_string()).collect();
+        let paths: Vec<String> = runs[0]
+            .overrides
+            .iter()
+            .map(|o| o.path.to_string())
+            .collect();
         assert_eq!(
             paths,
-            ["time_limit_s", "uav.0.behaviour.speed", "uav.0.behaviour.strategy"]
+            [
+                "time_limit_s",
+                "uav.0.behaviour.speed",
+                "uav.0.behaviour.strategy"
+            ]
         );
     }
 
@@ -288,7 +299,9 @@ mod tests {
         let ids: BTreeSet<&str> = runs.iter().map(|r| r.id.as_str()).collect();
         assert_eq!(ids.len(), runs.len());
         assert!(
-            runs[2].id.starts_with("a__speed=1.0__strategy=nearest_frontier__seed=4__"),
+            runs[2]
+                .id
+                .starts_with("a__speed=1.0__strategy=nearest_frontier__seed=4__"),
             "{}",
             runs[2].id
         );
@@ -297,7 +310,8 @@ mod tests {
         assert_eq!(fnv1a(b"a"), 0xaf63_dc4c_8601_ec8c);
         // A longer plan keeps the ids of the runs it shares with a shorter one.
         let longer = PLAN.replace("[4, 9]", "[4, 9, 10]");
-        let longer_ids: BTreeSet<String> = expand(&plan(&longer)).into_iter().map(|r| r.id).collect();
+        let longer_ids: BTreeSet<String> =
+            expand(&plan(&longer)).into_iter().map(|r| r.id).collect();
         assert!(ids.iter().all(|id| longer_ids.contains(*id)));
         // Another fixed override is another run.
         let other = PLAN.replace("time_limit_s = 3.0", "time_limit_s = 4.0");
@@ -345,9 +359,15 @@ mod tests {
         let runs = expand(&plan(PLAN));
         let record = runs[2].record();
         assert_eq!(record.coordinates[0].value, serde_json::json!(1.0));
-        assert_eq!(record.coordinates[1].value, serde_json::json!("nearest frontier"));
+        assert_eq!(
+            record.coordinates[1].value,
+            serde_json::json!("nearest frontier")
+        );
         assert_eq!(record.scenario, "dir/a.toml");
         let json = serde_json::to_string(&record).unwrap();
-        assert_eq!(serde_json::from_str::<RunCoordinates>(&json).unwrap(), record);
+        assert_eq!(
+            serde_json::from_str::<RunCoordinates>(&json).unwrap(),
+            record
+        );
     }
 }

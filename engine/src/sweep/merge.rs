@@ -5,9 +5,7 @@
 //! two folders is kept once; if its deterministic results differ between them, that is
 //! reported as a conflict. Runs of the plan present in no folder are reported as missing.
 
-use super::execute::{
-    PLAN_FILE, RUNS_DIR, SUMMARY_FILE, SweepError, io_error, is_finished,
-};
+use super::execute::{PLAN_FILE, RUNS_DIR, SUMMARY_FILE, SweepError, io_error, is_finished};
 use super::expand::expand;
 use super::plan::Plan;
 use crate::output::write_atomically;

@@ -145,37 +145,45 @@ impl Plan {
         let seeds = seeds(file.seeds).map_err(invalid)?;
 
         let mut set = Vec::new();
-        flatten(&file.set, &OverridePath::from_steps(&[]), &mut |path, value| {
-            set.push(Override {
-                path,
-                value: value.clone(),
-            });
-            Ok(())
-        })
+        flatten(
+            &file.set,
+            &OverridePath::from_steps(&[]),
+            &mut |path, value| {
+                set.push(Override {
+                    path,
+                    value: value.clone(),
+                });
+                Ok(())
+            },
+        )
         .map_err(|e| invalid(format!("[set]: {e}")))?;
 
         let mut grid = Vec::new();
-        flatten(&file.grid, &OverridePath::from_steps(&[]), &mut |path, value| {
-            let toml::Value::Array(values) = value else {
-                return Err(format!(
-                    "`{path}` must be a list of the values to try, e.g. `[{value}]`"
-                ));
-            };
-            if values.is_empty() {
-                return Err(format!("`{path}` has no value to try"));
-            }
-            let mut seen = BTreeSet::new();
-            for v in values {
-                if !seen.insert(v.to_string()) {
-                    return Err(format!("`{path}` lists {v} twice"));
+        flatten(
+            &file.grid,
+            &OverridePath::from_steps(&[]),
+            &mut |path, value| {
+                let toml::Value::Array(values) = value else {
+                    return Err(format!(
+                        "`{path}` must be a list of the values to try, e.g. `[{value}]`"
+                    ));
+                };
+                if values.is_empty() {
+                    return Err(format!("`{path}` has no value to try"));
                 }
-            }
-            grid.push(Axis {
-                path,
-                values: values.clone(),
-            });
-            Ok(())
-        })
+                let mut seen = BTreeSet::new();
+                for v in values {
+                    if !seen.insert(v.to_string()) {
+                        return Err(format!("`{path}` lists {v} twice"));
+                    }
+                }
+                grid.push(Axis {
+                    path,
+                    values: values.clone(),
+                });
+                Ok(())
+            },
+        )
         .map_err(|e| invalid(format!("[grid]: {e}")))?;
         let mut paths = BTreeSet::new();
         for axis in &grid {
@@ -370,6 +378,9 @@ mod tests {
              map = { resolution = [2] }",
         )
         .unwrap_err();
-        assert!(error.contains("`map.resolution` is written twice"), "{error}");
+        assert!(
+            error.contains("`map.resolution` is written twice"),
+            "{error}"
+        );
     }
 }

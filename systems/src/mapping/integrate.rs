@@ -258,16 +258,11 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 let x = (tx <= ty) & (tx <= tz);
                 let y = !x & (ty <= tz);
                 let z = !x & !y;
-                tx += if x { dtx } else { 0.0 };
-                ty += if y { dty } else { 0.0 };
-                tz += if z { dtz } else { 0.0 };
-                cursor.0 = cursor.0.wrapping_add(if x {
-                    cx
-                } else if y {
-                    cy
-                } else {
-                    cz
-                });
+                tx += masked(x, dtx);
+                ty += masked(y, dty);
+                tz += masked(z, dtz);
+                let step = (mask(x) & cx) | (mask(y) & cy) | (mask(z) & cz);
+                cursor.0 = cursor.0.wrapping_add(step);
                 if cursor.left_chunk() {
                     break;
                 }
@@ -282,6 +277,19 @@ impl<C: ChunkAccess> Integration<'_, C> {
         walk.resume(key, [tx, ty, tz]);
         visits
     }
+}
+
+/// All ones if `c`, else zero: selects by masking, which compilers keep branch-free (an `if`
+/// on a float comparison may be compiled to a branch, mispredicted every other step here).
+#[inline(always)]
+fn mask(c: bool) -> u64 {
+    u64::from(c).wrapping_neg()
+}
+
+/// `v` if `c`, else +0.0, branch-free (see [`mask`]).
+#[inline(always)]
+fn masked(c: bool, v: f64) -> f64 {
+    f64::from_bits(v.to_bits() & mask(c))
 }
 
 /// How close to the end of a segment (in segment parameter) a boundary must come to be left

@@ -1,0 +1,226 @@
+//! Piecewise-polynomial trajectories (the form minimum-snap planning produces).
+//!
+//! Each segment stores its polynomials in normalised time `tau = (t - t_start) / duration`,
+//! in [0, 1]: coefficients then stay of the size of the positions whatever the segment's
+//! duration, which keeps both the solver that writes them and the evaluation well conditioned.
+//! The derivative of order n in real time is the tau-derivative divided by `duration^n`.
+
+use super::{Trajectory, TrajectoryPoint};
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+/// Coefficients per polynomial: degree 7, the degree of minimum-snap segments
+/// (Richter, Bry & Roy 2013: 2 x 4 boundary conditions per segment).
+pub const POLYNOMIAL_COEFFICIENTS: usize = 8;
+
+/// Indices of the flat outputs in [`PolynomialSegment::coefficients`].
+const X: usize = 0;
+const Y: usize = 1;
+const Z: usize = 2;
+const YAW: usize = 3;
+
+/// One segment: x, y, z and yaw as polynomials in normalised time.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PolynomialSegment {
+    /// Length of the segment (s), > 0.
+    pub duration: f64,
+    /// `coefficients[output][k]` multiplies `tau^k`; outputs are x, y, z (m) and yaw (rad).
+    pub coefficients: [[f64; POLYNOMIAL_COEFFICIENTS]; 4],
+}
+
+impl PolynomialSegment {
+    /// Derivatives of order 0..=4 of one output with respect to real time, at normalised time
+    /// `tau`.
+    pub fn derivatives(&self, output: usize, tau: f64) -> [f64; 5] {
+        let c = &self.coefficients[output];
+        let inv_duration = 1.0 / self.duration;
+        let mut result = [0.0; 5];
+        let mut scale = 1.0;
+        for (order, value) in result.iter_mut().enumerate() {
+            // Horner on the order-th derivative: sum_k k!/(k-order)! c_k tau^(k-order).
+            let factors = &FALLING_FACTORIALS[order];
+            let mut acc = 0.0;
+            for k in (order..POLYNOMIAL_COEFFICIENTS).rev() {
+                acc = acc * tau + factors[k] * c[k];
+            }
+            *value = acc * scale;
+            scale *= inv_duration;
+        }
+        result
+    }
+
+    /// The reference at normalised time `tau` of this segment.
+    pub fn point(&self, tau: f64) -> TrajectoryPoint {
+        let x = self.derivatives(X, tau);
+        let y = self.derivatives(Y, tau);
+        let z = self.derivatives(Z, tau);
+        let yaw = self.derivatives(YAW, tau);
+        let v = |n: usize| DVec3::new(x[n], y[n], z[n]);
+        TrajectoryPoint {
+            position: v(0),
+            velocity: v(1),
+            acceleration: v(2),
+            jerk: v(3),
+            snap: v(4),
+            yaw: yaw[0],
+            yaw_rate: yaw[1],
+            yaw_acceleration: yaw[2],
+        }
+    }
+}
+
+/// `FALLING_FACTORIALS[n][k] = k! / (k - n)!` (0 for k < n): the factor of `c_k` in the n-th
+/// derivative of `sum c_k tau^k`.
+const FALLING_FACTORIALS: [[f64; POLYNOMIAL_COEFFICIENTS]; 5] = {
+    let mut table = [[0.0; POLYNOMIAL_COEFFICIENTS]; 5];
+    let mut n = 0;
+    while n < 5 {
+        let mut k = n;
+        while k < POLYNOMIAL_COEFFICIENTS {
+            let mut product = 1.0;
+            let mut i = k + 1 - n;
+            while i <= k {
+                product *= i as f64;
+                i += 1;
+            }
+            table[n][k] = product;
+            k += 1;
+        }
+        n += 1;
+    }
+    table
+};
+
+/// Segments flown one after the other.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PiecewisePolynomial {
+    segments: Vec<PolynomialSegment>,
+    /// Start time of each segment, then the total duration (len = segments + 1).
+    knots: Vec<f64>,
+}
+
+impl PiecewisePolynomial {
+    /// Joins segments; refuses an empty list, non-positive or non-finite durations and
+    /// non-finite coefficients.
+    pub fn new(segments: Vec<PolynomialSegment>) -> Result<Self, String> {
+        if segments.is_empty() {
+            return Err("a piecewise polynomial needs at least one segment".into());
+        }
+        let mut knots = Vec::with_capacity(segments.len() + 1);
+        let mut t = 0.0;
+        knots.push(t);
+        for (i, segment) in segments.iter().enumerate() {
+            if !(segment.duration.is_finite() && segment.duration > 0.0) {
+                return Err(format!(
+                    "segment {i} has duration {}, expected a finite value > 0",
+                    segment.duration
+                ));
+            }
+            if segment
+                .coefficients
+                .iter()
+                .flatten()
+                .any(|c| !c.is_finite())
+            {
+                return Err(format!("segment {i} has non-finite coefficients"));
+            }
+            t += segment.duration;
+            knots.push(t);
+        }
+        Ok(Self { segments, knots })
+    }
+
+    pub fn segments(&self) -> &[PolynomialSegment] {
+        &self.segments
+    }
+
+    /// Times at which the segments meet, from 0 to the duration (the waypoint times).
+    pub fn knots(&self) -> &[f64] {
+        &self.knots
+    }
+
+    /// The segment that holds time `t` (clamped to the trajectory) and the normalised time in it.
+    pub fn locate(&self, t: f64) -> (usize, f64) {
+        let last = self.segments.len() - 1;
+        let index = self.knots[1..=last]
+            .partition_point(|&knot| knot <= t)
+            .min(last);
+        let tau = (t - self.knots[index]) / self.segments[index].duration;
+        (index, tau.clamp(0.0, 1.0))
+    }
+}
+
+impl Trajectory for PiecewisePolynomial {
+    fn duration(&self) -> f64 {
+        self.knots[self.segments.len()]
+    }
+
+    fn sample(&self, t: f64) -> TrajectoryPoint {
+        if t >= self.duration() {
+            let end = self.segments[self.segments.len() - 1].point(1.0);
+            return TrajectoryPoint::at_rest(end.position, end.yaw);
+        }
+        let (index, tau) = self.locate(t);
+        self.segments[index].point(tau)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// x(t) = t^3 on a 2 s segment: in tau, x = 8 tau^3.
+    fn cubic_segment() -> PolynomialSegment {
+        let mut coefficients = [[0.0; POLYNOMIAL_COEFFICIENTS]; 4];
+        coefficients[X][3] = 8.0;
+        coefficients[YAW][1] = 1.0; // yaw(t) = t / 2
+        PolynomialSegment {
+            duration: 2.0,
+            coefficients,
+        }
+    }
+
+    #[test]
+    fn derivatives_are_in_real_time() {
+        let segment = cubic_segment();
+        // At t = 1 s (tau = 0.5): x = 1, x' = 3 t^2 = 3, x'' = 6 t = 6, x''' = 6, x'''' = 0.
+        let d = segment.derivatives(X, 0.5);
+        let expected = [1.0, 3.0, 6.0, 6.0, 0.0];
+        for (got, want) in d.iter().zip(expected) {
+            assert!((got - want).abs() < 1e-12, "{d:?}");
+        }
+        let point = segment.point(0.5);
+        assert!((point.yaw - 0.5).abs() < 1e-12);
+        assert!((point.yaw_rate - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sampling_finds_the_segment_and_holds_the_end() {
+        let mut second = cubic_segment();
+        // x continues from 8 m at rest: constant 8 over 1 s.
+        second.coefficients[X] = [8.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0];
+        second.duration = 1.0;
+        let trajectory = PiecewisePolynomial::new(vec![cubic_segment(), second]).unwrap();
+        assert_eq!(trajectory.duration(), 3.0);
+        assert_eq!(trajectory.knots(), &[0.0, 2.0, 3.0]);
+        assert!((trajectory.sample(1.0).position.x - 1.0).abs() < 1e-12);
+        assert_eq!(trajectory.locate(2.5), (1, 0.5));
+        assert!((trajectory.sample(2.5).position.x - 8.0).abs() < 1e-12);
+        let after = trajectory.sample(7.0);
+        assert!((after.position.x - 8.0).abs() < 1e-12);
+        assert_eq!(after.velocity, DVec3::ZERO);
+        // Before the start: the start itself.
+        assert_eq!(trajectory.sample(-1.0).position, DVec3::ZERO);
+    }
+
+    #[test]
+    fn bad_segments_are_refused() {
+        assert!(PiecewisePolynomial::new(vec![]).is_err());
+        let mut zero = cubic_segment();
+        zero.duration = 0.0;
+        assert!(PiecewisePolynomial::new(vec![zero]).is_err());
+        let mut nan = cubic_segment();
+        nan.coefficients[Y][2] = f64::NAN;
+        assert!(PiecewisePolynomial::new(vec![nan]).is_err());
+    }
+}

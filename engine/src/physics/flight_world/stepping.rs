@@ -1,0 +1,103 @@
+//! The two ways a step moves the bodies: rapier's whole pipeline (near geometry), or rapier's
+//! integration functions on each body (far from it); and the narrow-phase queries around them.
+
+use super::{FlightWorld, StepInput};
+use glam::DVec3;
+use rapier3d::prelude::*;
+
+impl FlightWorld {
+    /// Applies the wrenches as forces and runs rapier's whole pipeline.
+    pub(super) fn pipeline_step(&mut self, inputs: &[Option<StepInput>]) {
+        for (uav, input) in self.uavs.iter().zip(inputs) {
+            let Some(StepInput { force, torque, .. }) = input else {
+                continue;
+            };
+            let body = &mut self.bodies[uav.body];
+            body.reset_forces(false);
+            body.reset_torques(false);
+            body.add_force(force.as_vec3(), true);
+            body.add_torque(torque.as_vec3(), true);
+        }
+        self.pipeline.step(
+            Vector::new(0.0, 0.0, -self.gravity as f32),
+            &self.params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd_solver,
+            &(),
+            &(),
+        );
+        self.counts.pipeline_steps += 1;
+    }
+
+    /// Integrates each flying body with rapier's integration functions (module doc).
+    pub(super) fn free_step(&mut self, inputs: &[Option<StepInput>]) {
+        let dt = self.params.dt;
+        for (uav, input) in self.uavs.iter().zip(inputs) {
+            let Some(StepInput { force, torque, .. }) = input else {
+                continue;
+            };
+            let gravity = DVec3::new(0.0, 0.0, -self.gravity * uav.model.mass);
+            let body = &mut self.bodies[uav.body];
+            let forces = RigidBodyForces {
+                force: (*force + gravity).as_vec3(),
+                torque: torque.as_vec3(),
+                ..RigidBodyForces::default()
+            };
+            let before = RigidBodyVelocity {
+                linvel: body.linvel(),
+                angvel: body.angvel(),
+            };
+            let after = forces.integrate(dt, &before, body.mass_properties());
+            body.set_linvel(after.linvel, false);
+            body.set_angvel(after.angvel, false);
+            let angvel = body.angvel_with_gyroscopic_forces(dt);
+            body.set_angvel(angvel, false);
+            let velocity = RigidBodyVelocity {
+                linvel: after.linvel,
+                angvel,
+            };
+            let local_com = body.mass_properties().local_mprops.local_com;
+            let pose = velocity.integrate(dt, body.position(), &local_com);
+            body.set_position(pose, false);
+        }
+        self.counts.free_steps += 1;
+    }
+
+    /// Whether the narrow phase reports an intersection of this collider with anything.
+    pub(super) fn intersects_anything(&self, collider: ColliderHandle) -> bool {
+        self.narrow_phase
+            .intersection_pairs_with(collider)
+            .any(|(_, _, intersecting)| intersecting)
+    }
+
+    /// A zero-length pipeline step: inserts the colliders into the broad phase and updates
+    /// the narrow phase without moving anything.
+    pub(super) fn update_collision_detection(&mut self) {
+        let params = IntegrationParameters {
+            dt: 0.0,
+            ..self.params
+        };
+        self.pipeline.step(
+            Vector::new(0.0, 0.0, -self.gravity as f32),
+            &params,
+            &mut self.islands,
+            &mut self.broad_phase,
+            &mut self.narrow_phase,
+            &mut self.bodies,
+            &mut self.colliders,
+            &mut self.impulse_joints,
+            &mut self.multibody_joints,
+            &mut self.soft_bodies,
+            &mut self.ccd_solver,
+            &(),
+            &(),
+        );
+    }
+}

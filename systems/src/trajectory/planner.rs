@@ -1,0 +1,319 @@
+//! Minimum-snap trajectories through waypoints with a feasible time allocation, and their
+//! collision-free variant (Richter, Bry & Roy 2013).
+//!
+//! Time allocation: each segment starts with the time a rest-to-rest trapezoidal profile at
+//! (vmax, amax) would take over its straight length (and enough to turn the yaw at
+//! `max_yaw_rate`), which sets the segments' proportions. The minimum-snap solution then gets
+//! its exact peaks ([`super::limits`]), and every duration is scaled by the worst excess ratio
+//! `max(v/vmax, sqrt(a/amax))`. Uniform scaling keeps the shape of the path: from rest, speed
+//! scales as 1/s and acceleration as 1/s^2 exactly, so one round lands on the binding limit;
+//! from a moving start (whose velocity does not scale) a few rounds are needed. A solution
+//! slower than needed is tightened the same way. (Stretching only the offending segments
+//! does not work: a long segment between short ones bulges, and its peaks grow.)
+//!
+//! Collisions: when a segment of the solution crosses a blocked point, the midpoint of that
+//! segment's straight chord is added as a waypoint and the problem solved again (Richter et
+//! al., §IV), as long as that midpoint is free.
+
+use super::PlanError;
+use super::collision::first_blocked;
+use super::limits::segment_peaks;
+use super::min_snap::{JointConstraints, build_segments, solve_joint_derivatives};
+use glam::DVec3;
+use std::f64::consts::{PI, TAU};
+use uavex_components::airframe::Airframe;
+use uavex_components::trajectory::{PiecewisePolynomial, TrajectoryPoint};
+
+/// A point to pass through, with an optional heading there (None: the planner chooses).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Waypoint {
+    pub position: DVec3,
+    pub yaw: Option<f64>,
+}
+
+impl Waypoint {
+    pub fn new(position: DVec3) -> Self {
+        Self {
+            position,
+            yaw: None,
+        }
+    }
+}
+
+/// Limits the trajectory must respect everywhere.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DynamicLimits {
+    /// m/s.
+    pub max_velocity: f64,
+    /// m/s^2.
+    pub max_acceleration: f64,
+    /// rad/s, used for the time allocation of heading changes only.
+    pub max_yaw_rate: f64,
+}
+
+impl DynamicLimits {
+    /// The airframe's planning limits (EAAE Table 5.1 for the kingfisher) and a yaw rate of
+    /// 1 rad/s, which the slow yaw loop (kp_att_z = 3) follows.
+    pub fn of(airframe: &Airframe) -> Self {
+        Self {
+            max_velocity: airframe.max_velocity,
+            max_acceleration: airframe.max_acceleration,
+            max_yaw_rate: 1.0,
+        }
+    }
+
+    fn check(&self) -> Result<(), PlanError> {
+        for (name, value) in [
+            ("max_velocity", self.max_velocity),
+            ("max_acceleration", self.max_acceleration),
+            ("max_yaw_rate", self.max_yaw_rate),
+        ] {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(PlanError::InvalidLimits(format!("{name} = {value}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Rescaling rounds: one suffices from rest (exact scaling); a moving start needs a few.
+const MAX_ROUNDS: usize = 30;
+/// Ratios are pushed this far below 1 so that rounding never leaves a peak a hair above a limit.
+const MARGIN: f64 = 1.0 + 1e-6;
+
+/// Minimum-snap trajectory from `start` through `waypoints`, ending at rest, whose speed and
+/// acceleration stay within `limits` everywhere.
+pub fn plan_min_snap(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    limits: &DynamicLimits,
+) -> Result<PiecewisePolynomial, PlanError> {
+    limits.check()?;
+    check_inputs(start, waypoints)?;
+    let speed0 = start.velocity.length();
+    let acceleration0 = start.acceleration.length();
+    if speed0 > limits.max_velocity * MARGIN || acceleration0 > limits.max_acceleration * MARGIN {
+        return Err(PlanError::StartExceedsLimits(format!(
+            "speed {speed0:.3} m/s, acceleration {acceleration0:.3} m/s^2"
+        )));
+    }
+    let yaws = unwrapped_yaws(start.yaw, waypoints);
+    let mut durations = initial_durations(start, waypoints, &yaws, limits)?;
+    let ratios = |trajectory: &PiecewisePolynomial| -> Vec<f64> {
+        segment_peaks(trajectory)
+            .into_iter()
+            .map(|(v, a)| (v / limits.max_velocity).max((a / limits.max_acceleration).sqrt()))
+            .collect()
+    };
+    for _ in 0..MAX_ROUNDS {
+        let trajectory = solve_with_durations(start, waypoints, &yaws, &durations)?;
+        let worst = ratios(&trajectory).into_iter().fold(0.0, f64::max);
+        if worst <= 1.0 {
+            return Ok(
+                tighten(start, waypoints, &yaws, &durations, worst, &ratios).unwrap_or(trajectory)
+            );
+        }
+        durations.iter_mut().for_each(|d| *d *= worst * MARGIN);
+    }
+    Err(PlanError::LimitsUnreachable)
+}
+
+/// Scales every duration by `worst` (< 1) so that the binding limit is met with equality,
+/// if the result still holds every limit (it may not when the start is moving).
+fn tighten(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    yaws: &[Option<f64>],
+    durations: &[f64],
+    worst: f64,
+    ratios: &dyn Fn(&PiecewisePolynomial) -> Vec<f64>,
+) -> Option<PiecewisePolynomial> {
+    if worst >= 1.0 / MARGIN || worst <= 0.0 {
+        return None;
+    }
+    let scaled: Vec<f64> = durations.iter().map(|d| d * worst * MARGIN).collect();
+    let trajectory = solve_with_durations(start, waypoints, yaws, &scaled).ok()?;
+    ratios(&trajectory)
+        .iter()
+        .all(|&r| r <= 1.0)
+        .then_some(trajectory)
+}
+
+/// Minimum-snap trajectory with given segment durations (no limits enforced).
+pub fn min_snap_with_durations(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    durations: &[f64],
+) -> Result<PiecewisePolynomial, PlanError> {
+    check_inputs(start, waypoints)?;
+    if durations.len() != waypoints.len() || durations.iter().any(|d| !(d.is_finite() && *d > 0.0))
+    {
+        return Err(PlanError::Internal(format!(
+            "{} durations (all finite and > 0) are needed for {} waypoints",
+            durations.len(),
+            waypoints.len()
+        )));
+    }
+    let yaws = unwrapped_yaws(start.yaw, waypoints);
+    solve_with_durations(start, waypoints, &yaws, durations)
+}
+
+/// Like [`plan_min_snap`], and free of `blocked` points (sampled every `spacing` metres along
+/// the path; pass a predicate that already inflates obstacles by the UAV's radius).
+pub fn plan_collision_free(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    limits: &DynamicLimits,
+    blocked: &dyn Fn(DVec3) -> bool,
+    spacing: f64,
+) -> Result<PiecewisePolynomial, PlanError> {
+    check_inputs(start, waypoints)?;
+    if !(spacing.is_finite() && spacing > 0.0) {
+        return Err(PlanError::InvalidLimits(format!(
+            "sampling spacing {spacing}"
+        )));
+    }
+    if blocked(start.position) {
+        return Err(PlanError::StartBlocked);
+    }
+    if let Some(index) = waypoints.iter().position(|w| blocked(w.position)) {
+        return Err(PlanError::WaypointBlocked {
+            index,
+            position: waypoints[index].position,
+        });
+    }
+    let mut waypoints = waypoints.to_vec();
+    // Each insertion halves a chord; a path that still collides after this many has a chord
+    // through an obstacle, which midpoints cannot fix.
+    let max_insertions = 8 * waypoints.len() + 16;
+    for _ in 0..=max_insertions {
+        let trajectory = plan_min_snap(start, &waypoints, limits)?;
+        let Some((time_s, position)) =
+            first_blocked(&trajectory, blocked, spacing, limits.max_velocity)?
+        else {
+            return Ok(trajectory);
+        };
+        let (segment, _) = trajectory.locate(time_s);
+        let from = if segment == 0 {
+            start.position
+        } else {
+            waypoints[segment - 1].position
+        };
+        let midpoint = 0.5 * (from + waypoints[segment].position);
+        if blocked(midpoint) {
+            return Err(PlanError::Collision { time_s, position });
+        }
+        waypoints.insert(segment, Waypoint::new(midpoint));
+    }
+    Err(PlanError::LimitsUnreachable)
+}
+
+fn check_inputs(start: &TrajectoryPoint, waypoints: &[Waypoint]) -> Result<(), PlanError> {
+    if waypoints.is_empty() {
+        return Err(PlanError::NoWaypoints);
+    }
+    let start_values = [
+        start.position,
+        start.velocity,
+        start.acceleration,
+        start.jerk,
+    ];
+    if start_values.iter().any(|v| !v.is_finite())
+        || !(start.yaw.is_finite()
+            && start.yaw_rate.is_finite()
+            && start.yaw_acceleration.is_finite())
+    {
+        return Err(PlanError::NonFinite("start state".into()));
+    }
+    for (i, w) in waypoints.iter().enumerate() {
+        if !w.position.is_finite() || w.yaw.is_some_and(|y| !y.is_finite()) {
+            return Err(PlanError::NonFinite(format!("waypoint {i}")));
+        }
+    }
+    Ok(())
+}
+
+/// Waypoint yaws unwrapped so that each differs from the previous known one by at most pi:
+/// the heading turns the short way.
+fn unwrapped_yaws(start_yaw: f64, waypoints: &[Waypoint]) -> Vec<Option<f64>> {
+    let mut previous = start_yaw;
+    waypoints
+        .iter()
+        .map(|w| {
+            w.yaw.map(|yaw| {
+                let delta = (yaw - previous + PI).rem_euclid(TAU) - PI;
+                previous += delta;
+                previous
+            })
+        })
+        .collect()
+}
+
+/// Rest-to-rest trapezoidal time over each chord, and enough time to turn the heading.
+fn initial_durations(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    yaws: &[Option<f64>],
+    limits: &DynamicLimits,
+) -> Result<Vec<f64>, PlanError> {
+    let (v, a) = (limits.max_velocity, limits.max_acceleration);
+    let mut previous_position = start.position;
+    let mut previous_yaw = start.yaw;
+    let mut durations = Vec::with_capacity(waypoints.len());
+    for (index, (waypoint, yaw)) in waypoints.iter().zip(yaws).enumerate() {
+        let distance = waypoint.position.distance(previous_position);
+        let turn = yaw.map_or(0.0, |y| (y - previous_yaw).abs());
+        if distance < 1e-6 && turn < 1e-6 {
+            return Err(PlanError::CoincidentWaypoints { index });
+        }
+        let travel = if distance <= v * v / a {
+            2.0 * (distance / a).sqrt()
+        } else {
+            distance / v + v / a
+        };
+        durations.push(travel.max(turn / limits.max_yaw_rate).max(0.05));
+        previous_position = waypoint.position;
+        if let Some(y) = yaw {
+            previous_yaw = *y;
+        }
+    }
+    Ok(durations)
+}
+
+fn solve_with_durations(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    yaws: &[Option<f64>],
+    durations: &[f64],
+) -> Result<PiecewisePolynomial, PlanError> {
+    let last = waypoints.len();
+    let mut outputs: [Vec<[f64; 4]>; 4] = Default::default();
+    for (axis, output) in outputs.iter_mut().enumerate() {
+        let mut values = Vec::with_capacity(last + 1);
+        if axis < 3 {
+            values.push([
+                Some(start.position[axis]),
+                Some(start.velocity[axis]),
+                Some(start.acceleration[axis]),
+                Some(start.jerk[axis]),
+            ]);
+            for (i, w) in waypoints.iter().enumerate() {
+                let at_rest = if i + 1 == last { Some(0.0) } else { None };
+                values.push([Some(w.position[axis]), at_rest, at_rest, at_rest]);
+            }
+        } else {
+            values.push([
+                Some(start.yaw),
+                Some(start.yaw_rate),
+                Some(start.yaw_acceleration),
+                Some(0.0),
+            ]);
+            for (i, yaw) in yaws.iter().enumerate() {
+                let at_rest = if i + 1 == last { Some(0.0) } else { None };
+                values.push([*yaw, at_rest, at_rest, at_rest]);
+            }
+        }
+        *output = solve_joint_derivatives(durations, &JointConstraints { values })?;
+    }
+    PiecewisePolynomial::new(build_segments(durations, &outputs)).map_err(PlanError::Internal)
+}

@@ -383,14 +383,18 @@ impl Airframe {
         }
         if self.allocation_determinant().abs() < 1e-12 {
             return Err(
-                "the rotor layout cannot produce independent roll, pitch and yaw torques".into(),
+                "the rotor layout (arm_x, arm_y, torque_coefficient) cannot produce independent \
+                 roll, pitch and yaw torques"
+                    .into(),
             );
         }
         let (_, thrust_max) = self.rotor_thrust_range();
         let weight = self.mass * GRAVITY;
         if 4.0 * thrust_max <= weight {
             return Err(format!(
-                "the rotors lift at most {:.2} N, less than the weight {weight:.2} N",
+                "the rotors lift at most {:.2} N (4 x the lower of rotor_thrust_max and \
+                 thrust_coefficient x rotor_speed_max^2), less than the weight {weight:.2} N \
+                 (mass x g)",
                 4.0 * thrust_max
             ));
         }

@@ -14,6 +14,7 @@
 
 mod chunk;
 mod config;
+mod grid;
 mod index;
 mod stats;
 
@@ -22,8 +23,9 @@ pub use chunk::{
     local_index, local_key,
 };
 pub use config::{
-    ChunkGrid, LogOddsIncrements, MAX_BOX_VOXELS, MapConfig, MapConfigError, MapSettings,
-    floor_to_key, log_odds_to_milli, milli_to_log_odds,
+    LogOddsIncrements, MAX_BOX_VOXELS, MapConfig, MapConfigError, MapSettings, floor_to_key,
+    log_odds_to_milli, milli_to_log_odds,
 };
+pub use grid::ChunkGrid;
 pub use index::{ChunkIndex, ScanCounter};
 pub use stats::{ChunkStats, MapMetrics, MapTotals, STAT_ONE, StatEntry, StatSums, StatTables};

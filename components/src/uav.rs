@@ -49,4 +49,6 @@ pub enum UavEnded {
     Finished,
     /// Touched world geometry.
     Crashed { time_s: f64, position: Vec3 },
+    /// Drew the usable energy of its battery (flight dynamics only).
+    BatteryEmpty { time_s: f64, position: Vec3 },
 }

@@ -1,8 +1,10 @@
 //! uavex engine: scenario files, world building, the simulation loop, runs and their outputs.
 
+pub mod flight;
 pub mod formats;
 pub mod metrics;
 pub mod output;
+pub mod plot;
 pub mod physics;
 pub mod run;
 pub mod scenario;

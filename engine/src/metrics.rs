@@ -1,12 +1,14 @@
-//! What a run records while it runs: the map metrics over time, the UAVs' tracks, and the times
-//! at which exploration thresholds were crossed (common.md §5).
+//! What a run records while it runs: the map metrics over time, the UAVs' tracks (with power
+//! and rotor speeds for dynamic UAVs), the fleet's total power, and the times at which
+//! exploration thresholds were crossed (common.md §5).
 
 use bevy_ecs::prelude::*;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use serde::Serialize;
 use uavex_components::map::{MapConfig, MapMetrics, MapTotals};
 use uavex_components::sim::SimClock;
 use uavex_components::uav::{QuadState, Uav};
+use uavex_systems::flight::{EnergyMeter, FlightEnergy};
 
 /// Exploration thresholds whose crossing times the summary reports.
 pub const EXPLORED_THRESHOLDS: [f64; 4] = [0.50, 0.90, 0.95, 0.99];
@@ -30,6 +32,10 @@ pub struct UavRow {
     pub yaw: f32,
     pub speed: f32,
     pub path_length_m: f64,
+    /// Total rotor power (W) of the last physics step; `None` for a kinematic UAV.
+    pub power_w: Option<f64>,
+    /// Actual rotor speeds (rad/s) in the airframe's rotor order; `None` for a kinematic UAV.
+    pub rotor_speeds: Option<[f32; 4]>,
 }
 
 /// The run's record, filled in the Account stage.
@@ -45,6 +51,10 @@ pub struct RunRecord {
     /// Distance flown by each UAV (index = `Uav::index`).
     pub path_length_m: Vec<f64>,
     last_position: Vec<Option<Vec3>>,
+    /// The fleet's total rotor power over time (the sum over dynamic UAVs, every tick), for
+    /// the run's average, peak and spread of power; `None` while no UAV flies dynamically.
+    /// (Its path length is not used.)
+    pub fleet_power: Option<EnergyMeter>,
 }
 
 impl RunRecord {
@@ -57,7 +67,15 @@ impl RunRecord {
             threshold_times_s: [None; 4],
             path_length_m: vec![0.0; uav_count],
             last_position: vec![None; uav_count],
+            fleet_power: None,
         }
+    }
+
+    /// Adds one physics step of `dt` seconds at the fleet's total power `power_w`.
+    pub fn note_fleet_power(&mut self, dt: f64, power_w: f64) {
+        self.fleet_power
+            .get_or_insert_with(EnergyMeter::default)
+            .record(dt, power_w, DVec3::ZERO);
     }
 
     /// Marks the thresholds that `explored_fraction` has reached at `time_s`.
@@ -95,20 +113,27 @@ impl RunRecord {
     }
 }
 
-/// Account stage: path lengths every tick, thresholds every tick (O(1) from the map totals),
-/// series rows at the series rate.
+/// Account stage: path lengths and the fleet's power every tick, thresholds every tick (O(1)
+/// from the map totals), series rows at the series rate.
 pub fn record_metrics(
     clock: Res<SimClock>,
     config: Res<MapConfig>,
     totals: Res<MapTotals>,
     mut record: ResMut<RunRecord>,
-    uavs: Query<(&Uav, &QuadState)>,
+    uavs: Query<(&Uav, &QuadState, Option<&FlightEnergy>)>,
 ) {
     let time_s = clock.time_s();
     let mut uavs: Vec<_> = uavs.iter().collect();
-    uavs.sort_by_key(|(uav, _)| uav.index);
-    for (uav, state) in &uavs {
+    uavs.sort_by_key(|(uav, ..)| uav.index);
+    let mut fleet_power: Option<f64> = None;
+    for (uav, state, energy) in &uavs {
         record.note_position(uav.index, state.position);
+        if let Some(energy) = energy {
+            *fleet_power.get_or_insert(0.0) += energy.power_w;
+        }
+    }
+    if let Some(power_w) = fleet_power {
+        record.note_fleet_power(clock.dt, power_w);
     }
     let metrics = totals.metrics(&config);
     record.note_exploration(time_s, metrics.explored_fraction);
@@ -116,7 +141,7 @@ pub fn record_metrics(
         return;
     }
     record.map_rows.push(MapRow { time_s, metrics });
-    for (uav, state) in uavs {
+    for (uav, state, energy) in uavs {
         let forward = state.attitude * Vec3::X;
         let row = UavRow {
             time_s,
@@ -127,6 +152,8 @@ pub fn record_metrics(
             yaw: forward.y.atan2(forward.x),
             speed: state.velocity.length(),
             path_length_m: record.path_length_m[uav.index],
+            power_w: energy.map(|e| e.power_w),
+            rotor_speeds: energy.map(|_| state.rotor_speeds),
         };
         record.uav_rows.push(row);
     }
@@ -153,6 +180,20 @@ mod tests {
         r.note_position(1, Vec3::new(3.0, 4.0, 0.0));
         r.note_position(1, Vec3::new(3.0, 4.0, 2.0));
         assert_eq!(r.path_length_m, vec![0.0, 7.0]);
+    }
+
+    #[test]
+    fn fleet_power_is_absent_until_noted() {
+        let mut r = RunRecord::new(1.0, 1);
+        assert!(r.fleet_power.is_none());
+        // 0.5 s at 100 W, 0.5 s at 200 W: 150 J, mean 150 W, peak 200 W, std 50 W.
+        r.note_fleet_power(0.5, 100.0);
+        r.note_fleet_power(0.5, 200.0);
+        let fleet = r.fleet_power.as_ref().unwrap();
+        assert_eq!(fleet.energy_j, 150.0);
+        assert_eq!(fleet.average_power_w(), 150.0);
+        assert_eq!(fleet.peak_power_w, 200.0);
+        assert!((fleet.power_std_w() - 50.0).abs() < 1e-9);
     }
 
     #[test]

@@ -1,4 +1,5 @@
-//! Files a run writes: `summary.json`, `series.csv` (map metrics over time), `uavs.csv` (tracks).
+//! Files a run writes: `summary.json`, `series.csv` (map metrics over time), `uavs.csv` (tracks,
+//! with power and rotor speeds of dynamic UAVs; empty cells for kinematic ones).
 //! Every file is written to a temporary name and renamed, so a reader never sees half a file.
 
 use crate::metrics::{MapRow, UavRow};
@@ -7,14 +8,57 @@ use std::fmt::Write as _;
 use std::io;
 use std::path::Path;
 use uavex_components::sim::Outcome;
+use uavex_systems::flight::EnergySummary;
 
 /// Per-UAV part of the summary.
+///
+/// The energy fields (common.md §4-5) are those of the true flight, integrated every physics
+/// step; they are `null` for a kinematic (`scripted`) UAV, which has no dynamics to draw power.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct UavSummary {
     pub name: String,
     pub path_length_m: f64,
-    /// How this UAV ended: "finished", "crashed", or "flying" when the run ended first.
+    /// How this UAV ended: "finished", "crashed", "battery_empty", or "flying" when the run
+    /// ended first.
     pub status: String,
+    /// When a crashed UAV touched geometry, or a UAV's battery ran out (s); `null` otherwise.
+    pub ended_time_s: Option<f64>,
+    /// Where that happened (m, world frame); `null` otherwise.
+    pub ended_position: Option<[f32; 3]>,
+    /// Energy drawn by the rotors (J).
+    pub energy_j: Option<f64>,
+    /// Mean power over the UAV's flight (W).
+    pub avg_power_w: Option<f64>,
+    pub peak_power_w: Option<f64>,
+    /// Standard deviation of power over time (W).
+    pub power_std_w: Option<f64>,
+    /// Fraction of the battery's full capacity left at the end.
+    pub battery_soc_end: Option<f64>,
+}
+
+impl UavSummary {
+    /// A UAV's summary; `ended` is the time and place of a crash or an empty battery,
+    /// `energy` is `None` for a kinematic UAV.
+    pub fn new(
+        name: String,
+        path_length_m: f64,
+        status: String,
+        ended: Option<(f64, [f32; 3])>,
+        energy: Option<&EnergySummary>,
+    ) -> Self {
+        Self {
+            name,
+            path_length_m,
+            status,
+            ended_time_s: ended.map(|(t, _)| t),
+            ended_position: ended.map(|(_, p)| p),
+            energy_j: energy.map(|e| e.energy_j),
+            avg_power_w: energy.map(|e| e.avg_power_w),
+            peak_power_w: energy.map(|e| e.peak_power_w),
+            power_std_w: energy.map(|e| e.power_std_w),
+            battery_soc_end: energy.map(|e| e.battery_soc_end),
+        }
+    }
 }
 
 /// `summary.json`: one run, as a flat record (a row of a sweep's table).
@@ -49,6 +93,17 @@ pub struct RunSummary {
     pub time_to_explored_99_s: Option<f64>,
     /// Total distance flown by all UAVs.
     pub path_length_m: f64,
+    /// Energy drawn by all dynamic UAVs (J); `null` when no UAV flies dynamically (as for
+    /// every energy field below).
+    pub energy_j: Option<f64>,
+    /// Mean of the fleet's total power over the mission (W).
+    pub avg_power_w: Option<f64>,
+    /// Peak of the fleet's total power (W).
+    pub peak_power_w: Option<f64>,
+    /// Standard deviation of the fleet's total power over time (W).
+    pub power_std_w: Option<f64>,
+    /// The lowest state of charge among the UAVs' batteries at the end.
+    pub battery_soc_end: Option<f64>,
     pub uavs: Vec<UavSummary>,
     /// Host time the run took (s); the one field that is not deterministic.
     pub wall_time_s: f64,
@@ -96,12 +151,29 @@ pub fn map_series_csv(rows: &[MapRow]) -> String {
 
 /// The UAV tracks as CSV, one row per UAV per sample.
 pub fn uav_series_csv(rows: &[UavRow]) -> String {
-    let mut out = String::from("time_s,uav,x,y,z,yaw,speed,path_length_m\n");
+    let mut out = String::from(
+        "time_s,uav,x,y,z,yaw,speed,path_length_m,power_w,\
+         rotor_speed_0,rotor_speed_1,rotor_speed_2,rotor_speed_3\n",
+    );
     for r in rows {
+        let [w0, w1, w2, w3] = r.rotor_speeds.map_or([None; 4], |w| w.map(Some));
+        let w = |speed: Option<f32>| speed.map(|s| s.to_string()).unwrap_or_default();
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{}",
-            r.time_s, r.uav, r.x, r.y, r.z, r.yaw, r.speed, r.path_length_m
+            "{},{},{},{},{},{},{},{},{},{},{},{},{}",
+            r.time_s,
+            r.uav,
+            r.x,
+            r.y,
+            r.z,
+            r.yaw,
+            r.speed,
+            r.path_length_m,
+            cell(r.power_w),
+            w(w0),
+            w(w1),
+            w(w2),
+            w(w3),
         );
     }
     out

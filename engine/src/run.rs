@@ -16,6 +16,7 @@ use uavex_components::map::{MapConfig, MapTotals};
 use uavex_components::sim::{Outcome, SimClock};
 use uavex_components::uav::{Uav, UavEnded};
 use uavex_components::world::WorldGeometry;
+use uavex_systems::flight::{EnergySummary, FlightEnergy};
 use uavex_systems::mapping::{MapReader, OccupancyMap, map_accuracy};
 
 /// How to run a scenario.
@@ -82,12 +83,21 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
         map_accuracy(reader, |key| geometry.voxel_key_occupied(key, resolution))
     })
     .flatten();
-    let mut uavs: Vec<(usize, String, Option<UavEnded>)> = world
-        .query::<(&Uav, Option<&UavEnded>)>()
+    let mut uavs: Vec<(usize, String, Option<UavEnded>, Option<EnergySummary>)> = world
+        .query::<(&Uav, Option<&UavEnded>, Option<&FlightEnergy>)>()
         .iter(world)
-        .map(|(uav, ended)| (uav.index, uav.name.clone(), ended.cloned()))
+        .map(|(uav, ended, energy)| {
+            let energy = energy.map(FlightEnergy::summary);
+            (uav.index, uav.name.clone(), ended.cloned(), energy)
+        })
         .collect();
     uavs.sort_by_key(|(index, ..)| *index);
+    let energies: Vec<&EnergySummary> = uavs.iter().filter_map(|u| u.3.as_ref()).collect();
+    let energy_j = (!energies.is_empty()).then(|| energies.iter().map(|e| e.energy_j).sum());
+    let battery_soc_end = energies
+        .iter()
+        .map(|e| e.battery_soc_end)
+        .reduce(f64::min);
     let mut record = world.resource_mut::<RunRecord>();
     record.close(time_s, metrics);
     let record = world.resource::<RunRecord>();
@@ -116,16 +126,31 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
         time_to_explored_95_s: t95,
         time_to_explored_99_s: t99,
         path_length_m: record.path_length_m.iter().sum(),
+        energy_j,
+        avg_power_w: record.fleet_power.as_ref().map(|f| f.average_power_w()),
+        peak_power_w: record.fleet_power.as_ref().map(|f| f.peak_power_w),
+        power_std_w: record.fleet_power.as_ref().map(|f| f.power_std_w()),
+        battery_soc_end,
         uavs: uavs
             .into_iter()
-            .map(|(index, name, ended)| UavSummary {
-                name,
-                path_length_m: record.path_length_m[index],
-                status: match ended {
-                    None => "flying".to_owned(),
-                    Some(UavEnded::Finished) => "finished".to_owned(),
-                    Some(UavEnded::Crashed { .. }) => "crashed".to_owned(),
-                },
+            .map(|(index, name, ended, energy)| {
+                let (status, at) = match ended {
+                    None => ("flying", None),
+                    Some(UavEnded::Finished) => ("finished", None),
+                    Some(UavEnded::Crashed { time_s, position }) => {
+                        ("crashed", Some((time_s, position.to_array())))
+                    }
+                    Some(UavEnded::BatteryEmpty { time_s, position }) => {
+                        ("battery_empty", Some((time_s, position.to_array())))
+                    }
+                };
+                UavSummary::new(
+                    name,
+                    record.path_length_m[index],
+                    status.to_owned(),
+                    at,
+                    energy.as_ref(),
+                )
             })
             .collect(),
         wall_time_s: 0.0,

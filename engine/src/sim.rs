@@ -1,9 +1,12 @@
 //! The simulation of one run: a bevy `World` built from one scenario and one seed, and the
 //! `Tick` schedule with the pipeline stages (DESIGN.md "One tick").
 
+use crate::flight::{
+    Physics, airframe_of, end_on_empty_battery, step_physics, waypoint_flight,
+};
 use crate::metrics::{RunRecord, record_metrics};
 use crate::scenario::{BehaviourSpec, LoadedScenario, ScenarioErrors};
-use crate::world::{build_world, check_starts, sensor_bundle};
+use crate::world::{build_world, check_starts_with_radii, sensor_bundle};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::ScheduleSystem;
 use glam::{DVec3, Vec3};
@@ -11,14 +14,13 @@ use uavex_components::map::{MapConfig, MapSettings};
 use uavex_components::sensor::SensorId;
 use uavex_components::sim::{Outcome, RunEnd, RunSeed, SimClock};
 use uavex_components::uav::{QuadState, Uav, UavEnded};
+use uavex_components::world::WorldGeometry;
 use uavex_systems::behaviour::scripted::{ScriptedRoute, fly_scripted};
+use uavex_systems::behaviour::waypoints::finish_waypoint_tours;
+use uavex_systems::flight::track_references;
 use uavex_systems::mapping::{insert_map_resources, integrate_scans};
 use uavex_systems::sensing::sense;
 use uavex_systems::stages::{Stage, tick_schedule};
-
-/// Radius of the ball a UAV must fit in at its start (m): the kingfisher's arms (0.125 m to the
-/// rotor axes, common.md §3) plus a 5 cm rotor. Airframe data will supply it per UAV.
-pub const START_CLEARANCE_RADIUS: f32 = 0.175;
 
 /// One run in progress.
 pub struct Sim {
@@ -32,15 +34,28 @@ fn vec3(v: [f64; 3]) -> Vec3 {
 }
 
 impl Sim {
-    /// Builds the world of `loaded` for `seed`: geometry, map, UAVs with their sensors and
-    /// behaviours, and the tick schedule. Problems that need the geometry (a missing mesh file,
-    /// a start inside an obstacle) come back located in the scenario file.
+    /// Builds the world of `loaded` for `seed`: geometry, map, UAVs with their airframes,
+    /// sensors and behaviours (plans of dynamic behaviours included), the physics when a UAV
+    /// flies dynamically, and the tick schedule. Problems that need the airframes or the
+    /// geometry (an override that makes an airframe unflyable, a missing mesh file, a start
+    /// inside an obstacle, a waypoint tour through a wall) come back located in the file.
     pub fn build(loaded: &LoadedScenario, seed: u64) -> Result<Sim, ScenarioErrors> {
         let scenario = &loaded.scenario;
         let run_seed = RunSeed(seed);
         let locate = |errors: Vec<crate::world::BuildError>| {
             loaded.errors(errors.into_iter().map(|e| (e.path, e.message)))
         };
+        let mut airframes = Vec::with_capacity(scenario.uavs.len());
+        let mut airframe_problems = Vec::new();
+        for (index, spec) in scenario.uavs.iter().enumerate() {
+            match airframe_of(spec, index) {
+                Ok(airframe) => airframes.push(airframe),
+                Err(mut problems) => airframe_problems.append(&mut problems),
+            }
+        }
+        if !airframe_problems.is_empty() {
+            return Err(locate(airframe_problems));
+        }
         let starts: Vec<Vec3> = scenario
             .uavs
             .iter()
@@ -48,10 +63,26 @@ impl Sim {
             .collect();
         let geometry =
             build_world(&scenario.world, run_seed, &starts, &loaded.base_dir).map_err(locate)?;
-        let start_problems = check_starts(&geometry, &starts, START_CLEARANCE_RADIUS);
+        // Each UAV must fit, with its bounding sphere, where it starts.
+        let radii: Vec<f32> = airframes
+            .iter()
+            .map(|a| a.bounding_radius() as f32)
+            .collect();
+        let start_problems = check_starts_with_radii(&geometry, &starts, &radii);
         if !start_problems.is_empty() {
             return Err(locate(start_problems));
         }
+        let dynamic = scenario
+            .uavs
+            .iter()
+            .any(|u| matches!(u.behaviour, BehaviourSpec::Waypoints { .. }));
+        let mut physics = if dynamic {
+            let physics = Physics::new(&geometry, 1.0 / scenario.physics_rate_hz)
+                .map_err(|e| loaded.errors([("physics_rate_hz", e.to_string())]))?;
+            Some(physics)
+        } else {
+            None
+        };
         let map = MapConfig::new(&MapSettings {
             resolution: scenario.map.resolution,
             bounds_min: DVec3::from_array(scenario.world.bounds.min),
@@ -74,7 +105,7 @@ impl Sim {
 
         let mut problems = Vec::new();
         let mut next_sensor_id = 0;
-        for (index, spec) in scenario.uavs.iter().enumerate() {
+        for (index, (spec, airframe)) in scenario.uavs.iter().zip(&airframes).enumerate() {
             let state = QuadState::at_rest(starts[index], spec.start.yaw as f32);
             let uav = world
                 .spawn((
@@ -83,6 +114,7 @@ impl Sim {
                         index,
                     },
                     state,
+                    airframe.clone(),
                 ))
                 .id();
             match &spec.behaviour {
@@ -97,6 +129,31 @@ impl Sim {
                         yaw_rate: *yaw_rate as f32,
                         next: 0,
                     });
+                }
+                BehaviourSpec::Waypoints {
+                    waypoints,
+                    yaw,
+                    collision_check,
+                } => {
+                    // `dynamic` made the physics for exactly this case.
+                    let Some(physics) = physics.as_mut() else {
+                        continue;
+                    };
+                    match waypoint_flight(
+                        spec,
+                        index,
+                        airframe,
+                        world.resource::<WorldGeometry>(),
+                        physics,
+                        waypoints,
+                        yaw.as_deref(),
+                        *collision_check,
+                    ) {
+                        Ok(flight) => {
+                            world.entity_mut(uav).insert(flight);
+                        }
+                        Err(e) => problems.push(e),
+                    }
                 }
             }
             for (j, sensor) in spec.sensors.iter().enumerate() {
@@ -119,11 +176,20 @@ impl Sim {
         schedule.add_systems((
             sense.in_set(Stage::Sense),
             integrate_scans.in_set(Stage::Map),
-            fly_scripted.in_set(Stage::Control),
+            (fly_scripted, finish_waypoint_tours, track_references).in_set(Stage::Control),
             (record_metrics, end_when_every_uav_is_done)
                 .chain()
                 .in_set(Stage::Account),
         ));
+        if let Some(physics) = physics {
+            world.insert_resource(physics);
+            schedule.add_systems((
+                step_physics.in_set(Stage::Physics),
+                end_on_empty_battery
+                    .before(end_when_every_uav_is_done)
+                    .in_set(Stage::Account),
+            ));
+        }
         Ok(Sim {
             world,
             schedule,

@@ -311,7 +311,10 @@ fn pillars_tour_is_short_safe_and_looks_around() {
         speed,
         waypoints,
         yaw_rate,
-    } = &uav.behaviour;
+    } = &uav.behaviour
+    else {
+        panic!("the Pillars tour is scripted");
+    };
     assert_eq!(*speed, 1.5);
     // Walk the tour as the scripted behaviour flies it: turn in place the short way toward
     // the next waypoint at yaw_rate, then fly straight at speed.

@@ -2,7 +2,8 @@
 //! integrated.
 
 use super::chunk::{ChunkCoord, ScanId};
-use super::config::{ChunkGrid, MapConfig};
+use super::config::MapConfig;
+use super::grid::ChunkGrid;
 use crate::sensor::SensorId;
 use bevy_ecs::prelude::*;
 use std::collections::BTreeMap;

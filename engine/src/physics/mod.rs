@@ -10,6 +10,6 @@ mod fly;
 mod tests;
 
 pub use flight_world::{
-    FlightWorld, FlightWorldConfig, PhysicsError, StepCounts, UavHandle, UavStatus,
+    CrashTarget, FlightWorld, FlightWorldConfig, PhysicsError, StepCounts, UavHandle, UavStatus,
 };
 pub use fly::{FlightRecord, fly_trajectory};

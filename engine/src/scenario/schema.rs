@@ -272,7 +272,7 @@ pub struct QualitySpec {
     pub range_noise_std: f64,
 }
 
-/// What a UAV does. Later kinds (waypoints with dynamics, exploration, coverage) are added here.
+/// What a UAV does. Later kinds (exploration, coverage) are added here.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BehaviourSpec {
@@ -286,6 +286,24 @@ pub enum BehaviourSpec {
         /// Turn rate used to face the next leg (rad/s).
         #[serde(default = "defaults::yaw_rate")]
         yaw_rate: f64,
+    },
+    /// Dynamic: a minimum-snap trajectory through the waypoints (Richter, Bry & Roy), planned
+    /// when the run is built within the airframe's `max_velocity` and `max_acceleration`, and
+    /// flown on the true quadrotor (rapier) by the geometric controller, with its energy
+    /// integrated every physics step. Done once the UAV has arrived at the last waypoint.
+    Waypoints {
+        /// Positions to pass through in order, after the start position; the UAV stops at the
+        /// last one.
+        waypoints: Vec<[f64; 3]>,
+        /// Heading at each waypoint (rad), one per waypoint. Absent: each waypoint faces the
+        /// direction of travel there ("follow").
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        yaw: Option<Vec<f64>>,
+        /// Refuse (or bend around obstacles, where a midpoint helps) a plan that comes within
+        /// the airframe's bounding radius plus a 0.1 m margin of known geometry. `false` flies
+        /// the polynomial as it is, e.g. to study crashes.
+        #[serde(default = "defaults::yes")]
+        collision_check: bool,
     },
 }
 

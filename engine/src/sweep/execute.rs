@@ -50,6 +50,8 @@ pub struct SweepOptions {
     pub max_runs: Option<usize>,
     /// Draw a progress bar on stderr (only when stderr is a terminal).
     pub progress: bool,
+    /// Run again the runs that failed before (a failure is otherwise a finished result).
+    pub retry_failed: bool,
 }
 
 impl SweepOptions {
@@ -60,6 +62,7 @@ impl SweepOptions {
             shard: None,
             max_runs: None,
             progress: false,
+            retry_failed: false,
         }
     }
 }
@@ -129,7 +132,10 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
     };
     let mut todo: Vec<&RunSpec> = mine
         .iter()
-        .filter(|run| !is_finished(&runs_dir.join(&run.id)))
+        .filter(|run| {
+            let dir = runs_dir.join(&run.id);
+            !is_finished(&dir) || (options.retry_failed && has_failed(&dir))
+        })
         .collect();
     report.already_done = mine.len() - todo.len();
     if let Some(max) = options.max_runs
@@ -189,6 +195,14 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
 /// True when the run in `dir` has finished (its summary exists).
 pub fn is_finished(dir: &Path) -> bool {
     dir.join(SUMMARY_FILE).is_file()
+}
+
+/// True when the finished run in `dir` failed.
+pub fn has_failed(dir: &Path) -> bool {
+    std::fs::read_to_string(dir.join(SUMMARY_FILE))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .is_some_and(|summary| summary["outcome"] == "failed")
 }
 
 /// Runs one run into `dir`; `Err(reason)` when it failed (and its failed summary is written).

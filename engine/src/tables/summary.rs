@@ -25,7 +25,7 @@ const NOT_METRICS: [&str; 2] = ["seed", "wall_time_s"];
 pub const METRIC_LABELS: &[(&str, &str)] = &[
     ("mission_time_s", "Mission time (s)"),
     ("energy_j", "Energy (J)"),
-    ("average_power_w", "Average power (W)"),
+    ("avg_power_w", "Average power (W)"),
     ("power_std_w", "Power std (W)"),
     ("peak_power_w", "Peak power (W)"),
     ("explored_fraction", "Explored fraction"),
@@ -94,17 +94,24 @@ pub struct SummaryTable {
 
 /// Groups `rows` (in plan order, so groups come in plan order) and computes the statistics.
 pub fn summarise(rows: &[RunRow]) -> SummaryTable {
-    let mut metrics: Vec<String> = Vec::new();
+    // Fields in summary order (first appearance), kept if any run has a number there.
+    let mut fields: Vec<&str> = Vec::new();
     for row in rows {
-        for (name, cell) in &row.summary.0 {
-            if cell.as_f64().is_some()
-                && !NOT_METRICS.contains(&name.as_str())
-                && !metrics.contains(name)
-            {
-                metrics.push(name.clone());
+        for (name, _) in &row.summary.0 {
+            if !fields.contains(&name.as_str()) {
+                fields.push(name);
             }
         }
     }
+    let metrics: Vec<String> = fields
+        .into_iter()
+        .filter(|name| !NOT_METRICS.contains(name))
+        .filter(|name| {
+            rows.iter()
+                .any(|r| r.summary.get(name).and_then(Cell::as_f64).is_some())
+        })
+        .map(str::to_owned)
+        .collect();
     let mut keys: Vec<(String, Vec<(String, String)>)> = Vec::new();
     for row in rows {
         let key = row.group_key();

@@ -85,10 +85,20 @@ pub fn build_world(
 /// Refuses UAV starts that put a ball of `body_radius` (the airframe's bounding sphere) into an
 /// obstacle; `starts[i]` is reported as `uav[i].start.position`.
 pub fn check_starts(world: &WorldGeometry, starts: &[Vec3], body_radius: f32) -> Vec<BuildError> {
+    check_starts_with_radii(world, starts, &vec![body_radius; starts.len()])
+}
+
+/// [`check_starts`] with each UAV's own radius: `body_radii[i]` for `starts[i]`.
+pub fn check_starts_with_radii(
+    world: &WorldGeometry,
+    starts: &[Vec3],
+    body_radii: &[f32],
+) -> Vec<BuildError> {
     starts
         .iter()
+        .zip(body_radii)
         .enumerate()
-        .filter_map(|(i, &start)| {
+        .filter_map(|(i, (&start, &body_radius))| {
             let hit = world.obstacle_intersecting_ball(start, body_radius)?;
             let obstacle = &world.obstacles()[hit];
             Some(BuildError::new(

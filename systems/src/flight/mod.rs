@@ -1,12 +1,14 @@
 //! Flight with energy, as plain data and functions (common.md §3-4): the rotor power model,
 //! motor lag, the mixer, the SE(3) geometric controller, the quadrotor's rigid-body equations,
-//! energy and battery accounting, and the offline rollout.
+//! energy and battery accounting, and the offline rollout; [`ecs`] holds the components a
+//! dynamic UAV carries and the Control-stage system that tracks its reference.
 //!
 //! The true flight (engine, rapier) and the rollout call the same functions here, so the
 //! energy a planner predicts and the energy the flight integrates come from one model.
 
 pub mod controller;
 pub mod dynamics;
+pub mod ecs;
 pub mod energy;
 pub mod mixer;
 pub mod motor;
@@ -19,6 +21,9 @@ mod tests;
 
 pub use controller::{ControlOutput, ControllerGains, GeometricController};
 pub use dynamics::{QuadrotorModel, Wrench};
+pub use ecs::{
+    FlightController, FlightEnergy, ReferenceTrajectory, RotorCommands, track_references,
+};
 pub use energy::{Battery, EnergyMeter, EnergySummary};
 pub use rollout::{
     Completion, Integrator, Progress, RolloutConfig, RolloutResult, rollout, rollout_batch,

@@ -34,6 +34,19 @@ pub struct ClippedSegment {
 /// box (or only grazes its surface from outside).
 pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<ClippedSegment> {
     let inside = |k: IVec3| k.cmpge(lo).all() && k.cmple(hi).all();
+    // Points on the segment keep their key when inside (the same `floor` every key
+    // computation uses); entry and exit points are clamped into the box against rounding.
+    let (raw_start, raw_end) = (floor_to_key(start), floor_to_key(end));
+    let (start_inside, end_inside) = (inside(raw_start), inside(raw_end));
+    if start_inside && end_inside {
+        // The box is convex: nothing to clip (the common case, worth skipping the slabs).
+        return Some(ClippedSegment {
+            start_key: raw_start,
+            end_key: raw_end,
+            end_inside,
+            t_end: 1.0,
+        });
+    }
     let d = end - start;
     let (box_lo, box_hi) = (lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
     let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
@@ -49,13 +62,9 @@ pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<Cl
             t1 = t1.min(ta.max(tb));
         }
     }
-    let (raw_start, raw_end) = (floor_to_key(start), floor_to_key(end));
-    let (start_inside, end_inside) = (inside(raw_start), inside(raw_end));
     if t0 > t1 || (t0 == t1 && !start_inside && !end_inside) {
         return None;
     }
-    // Points on the segment keep their key when inside (the same `floor` every key
-    // computation uses); entry and exit points are clamped into the box against rounding.
     let key_at = |t: f64| floor_to_key(start + d * t).clamp(lo, hi);
     Some(ClippedSegment {
         start_key: if start_inside { raw_start } else { key_at(t0) },

@@ -77,6 +77,16 @@ pub enum UavStatus {
     },
 }
 
+/// What a crashed UAV touched.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CrashTarget {
+    /// A fixed collider, by its `user_data` (the engine's world colliders carry the index of
+    /// their obstacle there).
+    Fixed { user_data: u128 },
+    /// Another UAV, flying or a wreck.
+    Uav(UavHandle),
+}
+
 /// Why a flight world or a UAV could not be set up.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum PhysicsError {
@@ -122,7 +132,9 @@ struct FlyingUav {
     meter: EnergyMeter,
     battery: Battery,
     status: UavStatus,
-    /// Total power of the last step (W).
+    /// What it touched, once crashed.
+    crashed_into: Option<CrashTarget>,
+    /// Total power drawn during the last step (W); 0 once the UAV no longer flies.
     power_w: f64,
     /// Free distance (m) measured at `clearance_origin`: to the nearest fixed collider, minus
     /// `radius`.
@@ -257,6 +269,7 @@ impl FlightWorld {
             meter,
             battery: Battery::new(&airframe.battery),
             status: UavStatus::Flying,
+            crashed_into: None,
             power_w: total_power(&airframe.power, &state.rotor_speeds),
             clearance,
             clearance_origin: state.position,
@@ -286,6 +299,7 @@ impl FlightWorld {
         inputs.clear();
         for uav in &mut self.uavs {
             if uav.status != UavStatus::Flying {
+                uav.power_w = 0.0;
                 inputs.push(None);
                 continue;
             }
@@ -325,11 +339,18 @@ impl FlightWorld {
             let Some(input) = input else {
                 continue;
             };
-            let crashed = full && self.intersects_anything(self.uavs[index].collider);
+            let crashed_into = if full {
+                self.first_intersection(self.uavs[index].collider)
+            } else {
+                None
+            };
             let state = self.state(UavHandle(index));
             let uav = &mut self.uavs[index];
             let body = &mut self.bodies[uav.body];
-            if crashed {
+            if crashed_into.is_some() {
+                // The crash step's energy is not drawn (the step did not happen as flown).
+                uav.power_w = 0.0;
+                uav.crashed_into = crashed_into;
                 body.set_position(input.pose_before, false);
                 uav.status = UavStatus::Crashed {
                     time_s: time_before,
@@ -380,6 +401,11 @@ impl FlightWorld {
         self.uavs[uav.0].status
     }
 
+    /// What the UAV crashed into, if it crashed.
+    pub fn crashed_into(&self, uav: UavHandle) -> Option<CrashTarget> {
+        self.uavs[uav.0].crashed_into
+    }
+
     /// Energy integrated so far for this UAV.
     pub fn meter(&self, uav: UavHandle) -> &EnergyMeter {
         &self.uavs[uav.0].meter
@@ -389,7 +415,8 @@ impl FlightWorld {
         &self.uavs[uav.0].battery
     }
 
-    /// Total rotor power of the last step (W).
+    /// Total rotor power drawn during the last step (W): the power its energy was integrated
+    /// with; 0 in the step a UAV crashed and after it stopped flying.
     pub fn power_w(&self, uav: UavHandle) -> f64 {
         self.uavs[uav.0].power_w
     }

@@ -1,7 +1,7 @@
 //! The two ways a step moves the bodies: rapier's whole pipeline (near geometry), or rapier's
 //! integration functions on each body (far from it); and the narrow-phase queries around them.
 
-use super::{FlightWorld, StepInput};
+use super::{CrashTarget, FlightWorld, StepInput, UavHandle};
 use glam::DVec3;
 use rapier3d::prelude::*;
 
@@ -70,11 +70,19 @@ impl FlightWorld {
         self.counts.free_steps += 1;
     }
 
-    /// Whether the narrow phase reports an intersection of this collider with anything.
-    pub(super) fn intersects_anything(&self, collider: ColliderHandle) -> bool {
-        self.narrow_phase
+    /// What the narrow phase reports this collider intersecting, if anything (the first
+    /// pair in the intersection graph's order, which is deterministic).
+    pub(super) fn first_intersection(&self, collider: ColliderHandle) -> Option<CrashTarget> {
+        let (a, b, _) = self
+            .narrow_phase
             .intersection_pairs_with(collider)
-            .any(|(_, _, intersecting)| intersecting)
+            .find(|&(_, _, intersecting)| intersecting)?;
+        let other = if a == collider { b } else { a };
+        if let Some(index) = self.uavs.iter().position(|uav| uav.collider == other) {
+            return Some(CrashTarget::Uav(UavHandle(index)));
+        }
+        let user_data = self.colliders.get(other).map_or(0, |c| c.user_data);
+        Some(CrashTarget::Fixed { user_data })
     }
 
     /// A zero-length pipeline step: inserts the colliders into the broad phase and updates

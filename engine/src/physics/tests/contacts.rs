@@ -34,6 +34,12 @@ fn flying_into_a_wall_crashes_there() {
     assert!(time_s > 0.0 && time_s <= trajectory.duration());
     assert_eq!(world.status(uav), record.status);
     assert!(world.counts().pipeline_steps > 0 && world.counts().free_steps > 0);
+    // `from_shapes` leaves every collider's user data at 0; no power after the crash.
+    assert_eq!(
+        world.crashed_into(uav),
+        Some(CrashTarget::Fixed { user_data: 0 })
+    );
+    assert_eq!(world.power_w(uav), 0.0);
     // A crashed UAV no longer moves.
     let before = world.state(uav).position;
     world.step();
@@ -92,6 +98,8 @@ fn two_uavs_that_meet_both_crash() {
         world.status(a)
     );
     assert!(matches!(world.status(b), UavStatus::Crashed { .. }));
+    assert_eq!(world.crashed_into(a), Some(CrashTarget::Uav(b)));
+    assert_eq!(world.crashed_into(b), Some(CrashTarget::Uav(a)));
 }
 
 #[test]
@@ -113,6 +121,10 @@ fn an_empty_battery_ends_the_flight() {
     };
     assert!((time_s - 1.169).abs() < 0.005, "{time_s}");
     assert!((world.summary(uav).battery_soc_end - 0.2).abs() < 0.005);
+    // The step that spent the battery drew power; the next ones draw none.
+    assert!(world.power_w(uav) > 100.0);
+    world.step();
+    assert_eq!(world.power_w(uav), 0.0);
 }
 
 #[test]

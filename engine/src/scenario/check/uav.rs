@@ -97,23 +97,48 @@ fn check_behaviour(
         } => {
             positive(out, path.key("speed"), *speed);
             positive(out, path.key("yaw_rate"), *yaw_rate);
-            if waypoints.is_empty() {
+            check_waypoints(path, waypoints, context, out);
+        }
+        BehaviourSpec::Waypoints { waypoints, yaw, .. } => {
+            check_waypoints(path, waypoints, context, out);
+            if let Some(yaw) = yaw
+                && yaw.len() != waypoints.len()
+            {
                 out.push(Finding::must_be(
-                    path.key("waypoints"),
-                    "at least one waypoint",
-                    "an empty list",
+                    path.key("yaw"),
+                    format!(
+                        "one heading per waypoint ({}), or no `yaw` to face the direction of travel",
+                        waypoints.len()
+                    ),
+                    format!("{} headings", yaw.len()),
                 ));
             }
-            if let Some(bounds) = &context.bounds {
-                for (k, waypoint) in waypoints.iter().enumerate() {
-                    if !inside(*waypoint, bounds.min, bounds.max) {
-                        out.push(Finding::must_be(
-                            path.key("waypoints").index(k),
-                            within(bounds),
-                            triple(*waypoint),
-                        ));
-                    }
-                }
+        }
+    }
+}
+
+/// At least one waypoint, each inside the bounds.
+fn check_waypoints(
+    path: &FieldPath,
+    waypoints: &[[f64; 3]],
+    context: &Context,
+    out: &mut Vec<Finding>,
+) {
+    if waypoints.is_empty() {
+        out.push(Finding::must_be(
+            path.key("waypoints"),
+            "at least one waypoint",
+            "an empty list",
+        ));
+    }
+    if let Some(bounds) = &context.bounds {
+        for (k, waypoint) in waypoints.iter().enumerate() {
+            if !inside(*waypoint, bounds.min, bounds.max) {
+                out.push(Finding::must_be(
+                    path.key("waypoints").index(k),
+                    within(bounds),
+                    triple(*waypoint),
+                ));
             }
         }
     }

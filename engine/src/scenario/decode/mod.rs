@@ -157,6 +157,7 @@ fn quiet<T: DeserializeOwned>(node: &Node, path: &str) -> Option<T> {
     try_decode::<T>(node.get(path.segments())?, &path).ok()
 }
 
+/// One decoding attempt of a unit; errors without a place are the unit's own.
 pub(super) fn try_decode<T: DeserializeOwned>(node: &Node, root: &FieldPath) -> Result<T, DeError> {
     T::deserialize(NodeDeserializer::new(node, root.clone())).map_err(|error| error.at(root))
 }

@@ -1,0 +1,184 @@
+//! Sweeps: deterministic on any number of jobs, resumable after an interruption, and robust to
+//! failing runs (issue 5, "Must show").
+
+mod sweep_common;
+
+use std::collections::BTreeSet;
+use sweep_common::{SPEEDS, options, plan_in, plan_text_in, results, sweep, without_column};
+use uavex::engine::sweep::{expand, run_sweep};
+use uavex::engine::tables::write_tables;
+
+#[test]
+fn one_and_two_jobs_give_identical_per_run_results() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plan = plan_in(tmp.path(), SPEEDS);
+    let one = tmp.path().join("one");
+    let two = tmp.path().join("two");
+    let report_one = sweep(&plan, &one, 1);
+    let report_two = sweep(&plan, &two, 2);
+    assert_eq!((report_one.ran, report_one.failed.len()), (6, 0));
+    assert_eq!((report_two.ran, report_two.failed.len()), (6, 0));
+
+    let (a, b) = (results(&one), results(&two));
+    assert_eq!(a.len(), 6);
+    let ids: BTreeSet<String> = expand(&plan).into_iter().map(|r| r.id).collect();
+    assert_eq!(a.keys().cloned().collect::<BTreeSet<_>>(), ids);
+    assert_eq!(
+        a, b,
+        "per-run summaries and series differ between 1 and 2 jobs"
+    );
+    // The runs did map something, and the seeds and speeds made a difference.
+    let known: BTreeSet<u64> = a
+        .values()
+        .map(|(s, ..)| s["known_voxels"].as_u64().unwrap())
+        .collect();
+    assert!(known.iter().all(|&k| k > 500), "{known:?}");
+    assert!(known.len() >= 4, "runs should differ: {known:?}");
+
+    // Tables agree too, but for the host's wall time.
+    write_tables(&one).unwrap();
+    write_tables(&two).unwrap();
+    let read = |dir: &std::path::Path, name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
+    assert_eq!(read(&one, "summary.csv"), read(&two, "summary.csv"));
+    assert_eq!(read(&one, "summary.md"), read(&two, "summary.md"));
+    assert_eq!(
+        without_column(&read(&one, "runs.csv"), "wall_time_s"),
+        without_column(&read(&two, "runs.csv"), "wall_time_s")
+    );
+}
+
+#[test]
+fn an_interrupted_sweep_run_again_ends_with_every_run_exactly_once() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plan = plan_in(tmp.path(), SPEEDS);
+    let out = tmp.path().join("out");
+    let runs = expand(&plan);
+
+    // The first attempt stops after two runs...
+    let mut first = options(&out, 2);
+    first.max_runs = Some(2);
+    let report = run_sweep(&plan, &first).unwrap();
+    assert_eq!(
+        (report.ran, report.not_started, report.already_done),
+        (2, 4, 0)
+    );
+    let finished = |id: &str| out.join("runs").join(id).join("summary.json").is_file();
+    let done: Vec<bool> = runs.iter().map(|r| finished(&r.id)).collect();
+    assert_eq!(done, [true, true, false, false, false, false], "plan order");
+    let summary_of =
+        |id: &str| std::fs::read(out.join("runs").join(id).join("summary.json")).unwrap();
+    let before = [summary_of(&runs[0].id), summary_of(&runs[1].id)];
+
+    // ...and the third run was killed mid-way, leaving files but no summary.
+    let killed = out.join("runs").join(&runs[2].id);
+    std::fs::create_dir_all(&killed).unwrap();
+    std::fs::write(killed.join("series.csv"), "half a file").unwrap();
+
+    let report = sweep(&plan, &out, 2);
+    assert_eq!(
+        (report.already_done, report.ran, report.not_started),
+        (2, 4, 0)
+    );
+    // The first two runs were not run again (their summaries hold the first wall times).
+    assert_eq!(summary_of(&runs[0].id), before[0]);
+    assert_eq!(summary_of(&runs[1].id), before[1]);
+    // The killed run was redone from scratch.
+    let series = std::fs::read_to_string(killed.join("series.csv")).unwrap();
+    assert!(series.starts_with("time_s,explored_fraction"), "{series}");
+
+    // Every run of the plan exactly once, nothing else.
+    let folders: BTreeSet<String> = std::fs::read_dir(out.join("runs"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    let ids: BTreeSet<String> = runs.iter().map(|r| r.id.clone()).collect();
+    assert_eq!(folders, ids);
+    assert!(runs.iter().all(|r| finished(&r.id)));
+
+    // A third attempt has nothing left to do.
+    let report = sweep(&plan, &out, 2);
+    assert_eq!((report.already_done, report.ran), (6, 0));
+
+    // The same runs as an uninterrupted sweep.
+    let whole = tmp.path().join("whole");
+    sweep(&plan, &whole, 1);
+    assert_eq!(results(&out), results(&whole));
+}
+
+#[test]
+fn failing_runs_are_recorded_and_the_others_go_on() {
+    let tmp = tempfile::tempdir().unwrap();
+    // A negative resolution is refused by the scenario checks; a missing scenario file
+    // cannot be read; a list index beyond the UAVs cannot be overridden.
+    let plan = plan_text_in(
+        tmp.path(),
+        "seeds = 1\n\
+         [grid]\n\"map.resolution\" = [0.2, -0.1, 0.25]\n\
+         [[scenario]]\nfile = \"room.toml\"\n\
+         [[scenario]]\nfile = \"missing.toml\"\n",
+    );
+    let out = tmp.path().join("out");
+    let report = sweep(&plan, &out, 2);
+    assert_eq!(report.ran, 6);
+    let runs = expand(&plan);
+    let failed: Vec<&str> = report.failed.iter().map(|(id, _)| id.as_str()).collect();
+    assert_eq!(failed, [&runs[1].id, &runs[3].id, &runs[4].id, &runs[5].id]);
+    let (_, refused) = &report.failed[0];
+    assert!(
+        refused.starts_with("the scenario was refused") && refused.contains("map.resolution"),
+        "{refused}"
+    );
+    assert!(
+        report.failed[1].1.starts_with("cannot read the scenario")
+            && report.failed[1].1.contains("missing.toml"),
+        "{}",
+        report.failed[1].1
+    );
+
+    let all = results(&out);
+    assert_eq!(all.len(), 6, "every run has its summary, failed or not");
+    for (i, run) in runs.iter().enumerate() {
+        let summary = &all[&run.id].0;
+        let outcome = summary["outcome"].as_str().unwrap();
+        if i == 0 || i == 2 {
+            assert_eq!(outcome, "time_limit", "{}", run.id);
+            assert!(summary["known_voxels"].as_u64().unwrap() > 0);
+        } else {
+            assert_eq!(outcome, "failed", "{}", run.id);
+            assert!(!summary["reason"].as_str().unwrap().is_empty());
+            assert!(summary.get("known_voxels").is_none(), "no made-up metrics");
+        }
+    }
+
+    // The tables report the failures: the run table row by row, the summary by group.
+    write_tables(&out).unwrap();
+    let runs_csv = std::fs::read_to_string(out.join("runs.csv")).unwrap();
+    assert_eq!(runs_csv.matches(",failed,").count(), 4, "{runs_csv}");
+    let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+    assert!(
+        md.contains("| runs (failed) | 1 (0) | 1 (1) | 1 (0) |"),
+        "{md}"
+    );
+    assert!(md.contains("\n## missing\n"), "{md}");
+    assert!(
+        md.contains("| runs (failed) | 1 (1) | 1 (1) | 1 (1) |"),
+        "{md}"
+    );
+
+    // Running again does not retry failed runs: a failure is a result...
+    let again = sweep(&plan, &out, 2);
+    assert_eq!((again.already_done, again.ran), (6, 0));
+    // ...unless asked to, once the cause is fixed.
+    std::fs::write(tmp.path().join("missing.toml"), sweep_common::ROOM).unwrap();
+    let mut retry = options(&out, 2);
+    retry.retry_failed = true;
+    let again = run_sweep(&plan, &retry).unwrap();
+    assert_eq!(
+        (again.already_done, again.ran, again.failed.len()),
+        (2, 4, 1)
+    );
+    assert_eq!(
+        again.failed[0].0, runs[1].id,
+        "the bad resolution fails again"
+    );
+}

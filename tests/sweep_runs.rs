@@ -109,7 +109,7 @@ fn an_interrupted_sweep_run_again_ends_with_every_run_exactly_once() {
 fn failing_runs_are_recorded_and_the_others_go_on() {
     let tmp = tempfile::tempdir().unwrap();
     // A negative resolution is refused by the scenario checks; a missing scenario file
-    // cannot be read; a list index beyond the UAVs cannot be overridden.
+    // cannot be read.
     let plan = plan_text_in(
         tmp.path(),
         "seeds = 1\n\

@@ -1,11 +1,12 @@
 //! uavex engine: scenario files, world building, the simulation loop, runs and their outputs.
 
+pub mod coverage;
 pub mod flight;
 pub mod formats;
 pub mod metrics;
 pub mod output;
-pub mod plot;
 pub mod physics;
+pub mod plot;
 pub mod run;
 pub mod scenario;
 pub mod sim;

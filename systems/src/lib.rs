@@ -2,6 +2,7 @@
 //! functions over plain data (unit-tested without a World) and the thin ECS systems that apply
 //! them.
 pub mod behaviour;
+pub mod coverage;
 pub mod flight;
 pub mod mapping;
 pub mod sensing;

@@ -1,0 +1,54 @@
+//! Coverage planning in the engine (coverage.md): the scenario's coverage settings ([`spec`]),
+//! users' fields from GeoJSON and WKT ([`field`]), measurement logs as CSV ([`measurements`]),
+//! energy models by preset name or file ([`model_io`]), and the plan written as CSV, GeoJSON and
+//! a picture ([`outputs`], [`picture`]) with text reports for `uavex energy`, `uavex cover` and
+//! fitting ([`report`]). The planner and the energy model themselves live in
+//! [`uavex_systems::coverage`].
+
+pub mod field;
+pub mod measurements;
+pub mod model_io;
+pub mod outputs;
+pub mod picture;
+pub mod report;
+pub mod spec;
+
+pub use field::{Coordinates, Field, LocalProjection, read_field};
+pub use measurements::{fit_measurements, read_measurements, write_measurements};
+pub use model_io::{load_energy_model, save_fitted_model};
+pub use outputs::{PlanFiles, write_geojson, write_legs_csv, write_plan, write_waypoints_csv};
+pub use picture::write_picture;
+pub use report::{cover_report, energy_report, fit_report};
+pub use spec::{AreaSpec, CoverageSetup, CoverageSpec};
+
+use std::path::PathBuf;
+use thiserror::Error;
+use uavex_systems::coverage::{FitError, MissionError, PolygonError};
+
+/// Anything that goes wrong reading coverage inputs or writing coverage outputs, with the file.
+#[derive(Debug, Error)]
+pub enum CoverageIoError {
+    #[error("{path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// The file is readable but its content is not what was expected.
+    #[error("{path}: {message}")]
+    Content { path: PathBuf, message: String },
+    #[error("{path}: {source}")]
+    Polygon { path: PathBuf, source: PolygonError },
+    /// A coverage setting that makes no sense.
+    #[error("{path}: coverage {field}: {message}")]
+    Spec {
+        path: PathBuf,
+        field: String,
+        message: String,
+    },
+    #[error("{path}: cannot fit an energy model: {source}")]
+    Fit { path: PathBuf, source: FitError },
+    #[error("{path}: drawing failed: {message}")]
+    Picture { path: PathBuf, message: String },
+    #[error(transparent)]
+    Mission(#[from] MissionError),
+}

@@ -1,0 +1,344 @@
+//! The coverage behaviour's settings as they appear in a scenario file, under
+//! `[uav.behaviour] kind = "coverage"` (units as everywhere in scenarios: metres, seconds,
+//! radians; energy in joules):
+//!
+//! ```toml
+//! [uav.behaviour]
+//! kind = "coverage"
+//! area = { file = "fields/vineyard.geojson" }    # or { vertices = [[0, 0], [300, 0], ...] }
+//! camera = { angle_of_view = 1.6476, width_px = 4000, height_px = 3000, shot_period_s = 1.0 }
+//! overlap = { x = 0.2, y = 0.6 }
+//! resolution_px_per_m = 100.0                     # required ground resolution R_d
+//! available_energy_j = 150000.0                   # E_available
+//! energy_model = "iris"                           # preset, or a fitted-model file
+//! start_vertex = 0                                # take-off and landing, in the file's order
+//! direction = "longest_edge"                      # or "across_longest_edge"
+//! altitude = { step_m = 1.0, tolerance_j = 1000.0, min_altitude_m = 5.0, max_altitude_m = 120.0 }
+//! ```
+
+use super::CoverageIoError;
+use super::field::{Coordinates, LocalProjection, read_field};
+use super::model_io::load_energy_model;
+use super::outputs::{PlanFiles, write_plan};
+use super::report::cover_report;
+use glam::DVec2;
+use serde::Deserialize;
+use std::path::{Path, PathBuf};
+use uavex_systems::coverage::{
+    AltitudeOutcome, AltitudeSearch, Camera, CoverageProblem, Overlaps, Polygon, ScanDirection,
+    SpeedEnergyModel, search_altitude,
+};
+
+/// What a coverage mission surveys, with what, and on how much energy.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoverageSpec {
+    pub area: AreaSpec,
+    pub camera: Camera,
+    pub overlap: Overlaps,
+    /// Required ground resolution `R_d` (px/m).
+    pub resolution_px_per_m: f64,
+    /// Energy the battery makes available to the mission, `E_available` (J).
+    pub available_energy_j: f64,
+    /// A preset name (`iris`) or a model file (JSON/TOML, relative to the scenario file).
+    #[serde(default = "default_energy_model")]
+    pub energy_model: String,
+    /// The vertex where the UAV takes off and lands, as numbered in the input.
+    #[serde(default)]
+    pub start_vertex: usize,
+    #[serde(default)]
+    pub direction: ScanDirection,
+    #[serde(default)]
+    pub altitude: AltitudeSearch,
+}
+
+/// The field: vertices in metres, or a GeoJSON/WKT file (exactly one of the two).
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AreaSpec {
+    #[serde(default)]
+    pub vertices: Option<Vec<[f64; 2]>>,
+    /// Relative to the scenario file.
+    #[serde(default)]
+    pub file: Option<PathBuf>,
+    /// Overrides the file format's own convention (GeoJSON: lon/lat; WKT: metres).
+    #[serde(default)]
+    pub coordinates: Option<Coordinates>,
+}
+
+fn default_energy_model() -> String {
+    "iris".to_owned()
+}
+
+/// A resolved coverage spec: the planner's problem, the energy model and the battery.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoverageSetup {
+    pub problem: CoverageProblem,
+    pub model: SpeedEnergyModel,
+    pub available_energy_j: f64,
+    pub search: AltitudeSearch,
+    /// Set when the field came in longitude/latitude: outputs are written back in it.
+    pub projection: Option<LocalProjection>,
+}
+
+impl CoverageSpec {
+    /// Reads the field and the energy model (paths relative to `base_dir`) and validates
+    /// everything the planner relies on. `source` names the scenario file in errors.
+    pub fn resolve(
+        &self,
+        base_dir: &Path,
+        source: &Path,
+    ) -> Result<CoverageSetup, CoverageIoError> {
+        let spec_error = |field: &str, message: String| CoverageIoError::Spec {
+            path: source.to_owned(),
+            field: field.to_owned(),
+            message,
+        };
+        let (vertices, projection, origin) = match (&self.area.vertices, &self.area.file) {
+            (Some(vertices), None) => {
+                if self.area.coordinates == Some(Coordinates::Lonlat) {
+                    return Err(spec_error(
+                        "area.coordinates",
+                        "inline vertices are in metres; `lonlat` applies to files".to_owned(),
+                    ));
+                }
+                let points = vertices.iter().map(|&[x, y]| DVec2::new(x, y)).collect();
+                (points, None, source.to_owned())
+            }
+            (None, Some(file)) => {
+                let path = base_dir.join(file);
+                let field = read_field(&path, self.area.coordinates)?;
+                (field.vertices, field.projection, path)
+            }
+            _ => {
+                return Err(spec_error(
+                    "area",
+                    "give exactly one of `vertices` (metres) and `file` (GeoJSON or WKT)"
+                        .to_owned(),
+                ));
+            }
+        };
+        let count = vertices.len();
+        let polygon = Polygon::new(vertices).map_err(|source| CoverageIoError::Polygon {
+            path: origin,
+            source,
+        })?;
+        let start_vertex = polygon.index_of_input(self.start_vertex).ok_or_else(|| {
+            spec_error(
+                "start_vertex",
+                format!(
+                    "{} does not exist: the field has {count} vertices (0 to {})",
+                    self.start_vertex,
+                    polygon.len() - 1
+                ),
+            )
+        })?;
+        self.camera
+            .validate()
+            .map_err(|e| spec_error("camera", e.to_string()))?;
+        self.overlap
+            .validate()
+            .map_err(|e| spec_error("overlap", e.to_string()))?;
+        if !(self.resolution_px_per_m > 0.0 && self.resolution_px_per_m.is_finite()) {
+            return Err(spec_error(
+                "resolution_px_per_m",
+                format!("must be positive, got {}", self.resolution_px_per_m),
+            ));
+        }
+        if !(self.available_energy_j > 0.0 && self.available_energy_j.is_finite()) {
+            return Err(spec_error(
+                "available_energy_j",
+                format!("must be positive, got {}", self.available_energy_j),
+            ));
+        }
+        let model = load_energy_model(&self.energy_model, base_dir)?;
+        Ok(CoverageSetup {
+            problem: CoverageProblem {
+                polygon,
+                start_vertex,
+                camera: self.camera,
+                overlaps: self.overlap,
+                required_resolution_px_per_m: self.resolution_px_per_m,
+                direction: self.direction,
+            },
+            model,
+            available_energy_j: self.available_energy_j,
+            search: self.altitude,
+            projection,
+        })
+    }
+}
+
+impl CoverageSetup {
+    /// The altitude search of coverage.md: the plan at the best feasible altitude, or the
+    /// verdict that the battery does not suffice.
+    pub fn plan(&self) -> Result<AltitudeOutcome, CoverageIoError> {
+        Ok(search_altitude(
+            &self.problem,
+            &self.model,
+            self.available_energy_j,
+            &self.search,
+        )?)
+    }
+
+    /// The text `uavex cover` prints.
+    pub fn report(&self, outcome: &AltitudeOutcome) -> String {
+        cover_report(
+            &self.problem.polygon,
+            self.problem.required_resolution_px_per_m,
+            outcome,
+        )
+    }
+
+    /// Writes the plan as `<stem>_waypoints.csv`, `<stem>_legs.csv`, `<stem>.geojson`,
+    /// `<stem>.png` and `<stem>.svg` into `dir`, in the field's own coordinates.
+    pub fn write(
+        &self,
+        outcome: &AltitudeOutcome,
+        dir: &Path,
+        stem: &str,
+    ) -> Result<PlanFiles, CoverageIoError> {
+        write_plan(
+            self.problem.polygon.vertices(),
+            &outcome.plan,
+            self.projection.as_ref(),
+            dir,
+            stem,
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SPEC: &str = r#"
+        area = { vertices = [[0, 0], [0, 150], [300, 150], [300, 0]] }
+        camera = { angle_of_view = 1.5707963267948966, width_px = 4000, height_px = 3000, shot_period_s = 1.0 }
+        overlap = { x = 0.2, y = 0.3 }
+        resolution_px_per_m = 100.0
+        available_energy_j = 200000.0
+        start_vertex = 2
+        altitude = { step_m = 0.5 }
+    "#;
+
+    #[test]
+    fn inline_spec_resolves_and_plans() {
+        let spec: CoverageSpec = toml::from_str(SPEC).unwrap();
+        assert_eq!(spec.energy_model, "iris");
+        assert_eq!(spec.altitude.step_m, 0.5);
+        assert_eq!(spec.altitude.max_altitude_m, 120.0);
+        let setup = spec
+            .resolve(Path::new("."), Path::new("test.toml"))
+            .unwrap();
+        // The clockwise input is stored counter-clockwise; input vertex 2 is (300, 150).
+        let start = setup.problem.polygon.vertices()[setup.problem.start_vertex];
+        assert_eq!(start, DVec2::new(300.0, 150.0));
+        let outcome = setup.plan().unwrap();
+        assert_eq!(outcome.plan.path.waypoints[0].position, start);
+        assert!(outcome.plan.energy_j < 200000.0);
+    }
+
+    #[test]
+    fn geojson_field_in_lonlat_end_to_end() {
+        let dir = tempfile::tempdir().unwrap();
+        // About 157 m x 111 m with a notch, in longitude/latitude.
+        std::fs::write(
+            dir.path().join("field.geojson"),
+            r#"{"type": "Feature", "properties": {}, "geometry": {"type": "Polygon",
+                "coordinates": [[[11.0, 45.0], [11.002, 45.0], [11.002, 45.001],
+                [11.0012, 45.001], [11.001, 45.0004], [11.0008, 45.001], [11.0, 45.001],
+                [11.0, 45.0]]]}}"#,
+        )
+        .unwrap();
+        let text = SPEC.replace(
+            "area = { vertices = [[0, 0], [0, 150], [300, 150], [300, 0]] }",
+            "area = { file = \"field.geojson\" }",
+        );
+        let spec: CoverageSpec = toml::from_str(&text).unwrap();
+        let setup = spec
+            .resolve(dir.path(), &dir.path().join("s.toml"))
+            .unwrap();
+        assert!(setup.projection.is_some());
+        let outcome = setup.plan().unwrap();
+        assert_eq!(outcome.plan.path.areas, 3);
+        let report = setup.report(&outcome);
+        assert!(report.contains("7 vertices"), "{report}");
+        let files = setup
+            .write(&outcome, &dir.path().join("out"), "vineyard")
+            .unwrap();
+        let geojson: geojson::GeoJson = std::fs::read_to_string(&files.geojson)
+            .unwrap()
+            .parse()
+            .unwrap();
+        let geojson::GeoJson::FeatureCollection(fc) = geojson else {
+            panic!("not a collection")
+        };
+        let geometry = fc.features[0].geometry.as_ref().unwrap();
+        let geojson::GeometryValue::Polygon { coordinates } = &geometry.value else {
+            panic!("the field is not a polygon")
+        };
+        // The field comes back where it was, in degrees.
+        let first = coordinates[0][0].as_slice();
+        assert!((first[0] - 11.0).abs() < 1e-12 && (first[1] - 45.0).abs() < 1e-12);
+        assert!(files.png.exists() && files.svg.exists());
+    }
+
+    #[test]
+    fn embeds_in_an_internally_tagged_behaviour() {
+        // As the scenario schema embeds it: `[uav.behaviour] kind = "coverage"`.
+        #[derive(Deserialize)]
+        #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+        enum Behaviour {
+            Coverage(CoverageSpec),
+        }
+        let text = format!("kind = \"coverage\"\n{SPEC}");
+        let Behaviour::Coverage(spec) = toml::from_str(&text).unwrap();
+        assert_eq!(spec.start_vertex, 2);
+        let typo = format!("kind = \"coverage\"\nstart_vertx = 1\n{SPEC}");
+        let err = toml::from_str::<Behaviour>(&typo)
+            .err()
+            .unwrap()
+            .to_string();
+        assert!(err.contains("unknown field `start_vertx`"), "{err}");
+    }
+
+    #[test]
+    fn bad_specs_name_the_field() {
+        let resolve = |text: &str| {
+            toml::from_str::<CoverageSpec>(text)
+                .unwrap()
+                .resolve(Path::new("."), Path::new("s.toml"))
+                .unwrap_err()
+                .to_string()
+        };
+        let err = resolve(&SPEC.replace("start_vertex = 2", "start_vertex = 9"));
+        assert!(
+            err.contains("start_vertex: 9 does not exist: the field has 4 vertices"),
+            "{err}"
+        );
+        let err = resolve(&SPEC.replace("[300, 150], [300, 0]", "[300, 0], [300, 150]"));
+        assert!(err.contains("intersects itself"), "{err}");
+        let err =
+            resolve(&SPEC.replace("available_energy_j = 200000.0", "available_energy_j = -5"));
+        assert!(
+            err.contains("available_energy_j: must be positive"),
+            "{err}"
+        );
+        let err = resolve(&SPEC.replace("x = 0.2", "x = 1.5"));
+        assert!(
+            err.contains("overlap: overlap along x must lie in [0, 1)"),
+            "{err}"
+        );
+        let err = resolve(&SPEC.replace(
+            "area = { vertices",
+            "energy_model = \"nope\"\narea = { vertices",
+        ));
+        assert!(err.contains("not a preset energy model"), "{err}");
+        let err = resolve(&SPEC.replace(
+            "area = { vertices = [[0, 0], [0, 150], [300, 150], [300, 0]] }",
+            "area = {}",
+        ));
+        assert!(err.contains("give exactly one of `vertices`"), "{err}");
+    }
+}

@@ -67,6 +67,53 @@ enum Command {
     },
     /// Redraw the plots of a results folder (into DIR/plots).
     Plot { dir: PathBuf },
+    /// Optimal speed v*(d), energy E(d, v*) and time t(d) of a straight leg from rest to rest
+    /// under a speed-based energy model (coverage.md).
+    Energy {
+        /// A preset name (`iris`) or a fitted-model file (JSON or TOML).
+        model: String,
+        /// Leg length (m).
+        #[arg(long)]
+        distance: f64,
+    },
+    /// Plan the energy-aware coverage of a scenario's `kind = "coverage"` UAV: prints the plan
+    /// and writes the path (CSV, GeoJSON) and a picture (PNG, SVG).
+    Cover {
+        scenario: PathBuf,
+        /// Folder for the outputs (default: the current folder).
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Also fly the plan on the simulated quadrotor of the scenario's airframe and compare
+        /// the predicted energy and time with the flown ones.
+        #[arg(long)]
+        fly: bool,
+    },
+    /// Fly the energy-model experiments (accelerate, brake, constant-speed legs, hover, climb,
+    /// descend, turn in place) on a simulated airframe and fit a speed-based energy model.
+    Calibrate {
+        /// Airframe preset name (kingfisher, iris).
+        airframe: String,
+        /// The fitted model file, .json or .toml (default: AIRFRAME_energy.json); the fit
+        /// report and the measurement log are written beside it.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Override an airframe field, as a scenario's `airframe_overrides` (repeatable),
+        /// e.g. `--set drag_body=0.3`.
+        #[arg(long = "set", value_name = "NAME=VALUE", value_parser = parse_override)]
+        overrides: Vec<(String, f64)>,
+    },
+}
+
+/// `NAME=VALUE` of `uavex calibrate --set`.
+fn parse_override(text: &str) -> Result<(String, f64), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, got `{text}`"))?;
+    let value = value
+        .trim()
+        .parse()
+        .map_err(|e| format!("`{value}` is not a number: {e}"))?;
+    Ok((name.trim().to_owned(), value))
 }
 
 /// Exit code for a scenario that cannot be run as written.
@@ -93,6 +140,13 @@ fn main() -> ExitCode {
             sweep_command(&plan, options)
         }
         Command::Merge { out, shards } => merge_command(&out, &shards),
+        Command::Energy { model, distance } => energy_command(&model, distance),
+        Command::Cover { scenario, out, fly } => cover_command(&scenario, out.as_deref(), fly),
+        Command::Calibrate {
+            airframe,
+            out,
+            overrides,
+        } => calibrate_command(&airframe, out, &overrides.into_iter().collect()),
         Command::Plot { dir } => match uavex_engine::plot::plot_dir(&dir) {
             Ok(files) => {
                 println!(
@@ -260,6 +314,189 @@ fn write_results(dir: &std::path::Path) -> ExitCode {
         }
         Err(e) => {
             eprintln!("cannot plot {}: {e}", dir.display());
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `uavex energy`: the straight-leg figures of a preset or fitted speed-based model.
+fn energy_command(model: &str, distance: f64) -> ExitCode {
+    use uavex_engine::coverage::{energy_report, load_energy_model};
+    let report = load_energy_model(model, std::path::Path::new("."))
+        .map_err(|e| e.to_string())
+        .and_then(|m| energy_report(&m, distance).map_err(|e| e.to_string()));
+    match report {
+        Ok(text) => {
+            print!("{text}");
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("{e}");
+            ExitCode::from(INVALID_INPUT)
+        }
+    }
+}
+
+/// `uavex cover`: plans the scenario's coverage UAV, prints the plan, writes the files.
+fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly: bool) -> ExitCode {
+    use uavex_engine::coverage::read_coverage_scenario;
+    let setup = read_coverage_scenario(scenario).and_then(|s| {
+        let setup = s.spec.resolve(s.base_dir(), &s.path)?;
+        Ok((s, setup))
+    });
+    let (coverage, setup) = match setup {
+        Ok(found) => found,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(INVALID_INPUT);
+        }
+    };
+    let outcome = match setup.plan() {
+        Ok(outcome) => outcome,
+        Err(e) => {
+            eprintln!("{}: {e}", scenario.display());
+            return ExitCode::from(INVALID_INPUT);
+        }
+    };
+    print!("{}", setup.report(&outcome));
+    let dir = out.unwrap_or(std::path::Path::new("."));
+    match setup.write(&outcome, dir, &coverage.name) {
+        Ok(files) => {
+            for file in [
+                &files.waypoints_csv,
+                &files.legs_csv,
+                &files.geojson,
+                &files.png,
+                &files.svg,
+            ] {
+                println!("wrote {}", file.display());
+            }
+        }
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::FAILURE;
+        }
+    }
+    if !fly {
+        return ExitCode::SUCCESS;
+    }
+    let flown = uavex_components::airframe::Airframe::preset(&coverage.airframe)
+        .and_then(|mut a| a.apply_overrides(&coverage.airframe_overrides).map(|()| a))
+        .map_err(|e| format!("airframe `{}`: {e}", coverage.airframe))
+        .and_then(|airframe| {
+            uavex_engine::coverage::fly_plan(&airframe, &outcome.plan, &setup.model)
+                .map_err(|e| e.to_string())
+        });
+    match flown {
+        Ok(c) => {
+            println!(
+                "flown on the simulated {} with model `{}`:",
+                coverage.airframe, setup.model.name
+            );
+            println!(
+                "  energy  predicted {:>10.1} J   flown {:>10.1} J   ({:+.2} %)",
+                c.predicted_energy_j,
+                c.flown_energy_j,
+                100.0 * c.energy_error
+            );
+            println!(
+                "  time    predicted {:>10.1} s   flown {:>10.1} s   ({:+.2} %)",
+                c.predicted_time_s,
+                c.flown_time_s,
+                100.0 * c.time_error
+            );
+            let path = dir.join(format!("{}_flown.json", coverage.name));
+            match serde_json::to_string_pretty(&c)
+                .map_err(|e| e.to_string())
+                .and_then(|text| std::fs::write(&path, text).map_err(|e| e.to_string()))
+            {
+                Ok(()) => {
+                    println!("wrote {}", path.display());
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("{}: {e}", path.display());
+                    ExitCode::FAILURE
+                }
+            }
+        }
+        Err(e) => {
+            eprintln!("{e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// `uavex calibrate`: flies the experiments, fits, writes the model, its report and the log,
+/// and checks the model on fresh legs.
+fn calibrate_command(
+    airframe_name: &str,
+    out: Option<PathBuf>,
+    overrides: &std::collections::BTreeMap<String, f64>,
+) -> ExitCode {
+    use uavex_engine::coverage::{
+        CalibrationPlan, calibrate, check_legs, fit_report, save_fitted_model, write_measurements,
+    };
+    let airframe = match uavex_components::airframe::Airframe::preset(airframe_name)
+        .and_then(|mut a| a.apply_overrides(overrides).map(|()| a))
+    {
+        Ok(airframe) => airframe,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::from(INVALID_INPUT);
+        }
+    };
+    let out = out.unwrap_or_else(|| PathBuf::from(format!("{airframe_name}_energy.json")));
+    let plan = CalibrationPlan::for_airframe(&airframe);
+    let calibration = match calibrate(airframe_name, &airframe, &plan) {
+        Ok(calibration) => calibration,
+        Err(e) => {
+            eprintln!("{e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let report = fit_report(&calibration.fitted);
+    println!("{}", report.trim_end());
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty())
+        && let Err(e) = std::fs::create_dir_all(dir)
+    {
+        eprintln!("cannot create {}: {e}", dir.display());
+        return ExitCode::FAILURE;
+    }
+    let stem = out.with_extension("");
+    let report_path = PathBuf::from(format!("{}_fit.txt", stem.display()));
+    let log_path = PathBuf::from(format!("{}_measurements.csv", stem.display()));
+    let written = save_fitted_model(&calibration.fitted, &out)
+        .map_err(|e| e.to_string())
+        .and_then(|()| std::fs::write(&report_path, &report).map_err(|e| e.to_string()))
+        .and_then(|()| write_measurements(&log_path, &calibration.log).map_err(|e| e.to_string()));
+    if let Err(e) = written {
+        eprintln!("{e}");
+        return ExitCode::FAILURE;
+    }
+    for path in [&out, &report_path, &log_path] {
+        println!("wrote {}", path.display());
+    }
+    // Fresh legs: lengths and speeds the calibration did not fly.
+    let top = airframe.max_velocity;
+    let legs = [(17.0, 0.33 * top), (43.0, 0.57 * top), (95.0, 0.83 * top)];
+    match check_legs(&airframe, &calibration.fitted.model, &legs) {
+        Ok(checks) => {
+            println!("fresh legs, E(d, v) predicted by the fit against flown:");
+            for c in checks {
+                println!(
+                    "  {:>6.1} m at {:>5.2} m/s: predicted {:>8.1} J, flown {:>8.1} J ({:+.2} %)",
+                    c.distance_m,
+                    c.speed,
+                    c.predicted_j,
+                    c.flown_j,
+                    100.0 * c.error
+                );
+            }
+            ExitCode::SUCCESS
+        }
+        Err(e) => {
+            eprintln!("{e}");
             ExitCode::FAILURE
         }
     }

@@ -92,7 +92,10 @@ fn the_pillars_tour_completes_with_plausible_energy_and_series() {
     for line in lines {
         let row: Vec<&str> = line.split(',').collect();
         let speeds: Vec<f64> = row[w0..=w3].iter().map(|s| s.parse().unwrap()).collect();
-        let from_speeds = total_power(&airframe.power, &[speeds[0], speeds[1], speeds[2], speeds[3]]);
+        let from_speeds = total_power(
+            &airframe.power,
+            &[speeds[0], speeds[1], speeds[2], speeds[3]],
+        );
         let recorded: f64 = row[power].parse().unwrap();
         assert!(
             (recorded - from_speeds).abs() < 0.05 * recorded,
@@ -117,13 +120,28 @@ fn the_rollout_of_the_planned_tour_predicts_the_flown_energy() {
         .clone();
     let airframe = Airframe::kingfisher();
     let start = FlightState::hovering(&airframe, glam::DVec3::new(0.0, 0.0, 1.0), 0.0);
-    let predicted = rollout(&airframe, &start, reference.as_ref(), &RolloutConfig::default())
-        .unwrap();
+    let predicted = rollout(
+        &airframe,
+        &start,
+        reference.as_ref(),
+        &RolloutConfig::default(),
+    )
+    .unwrap();
     // EAAE's estimator (0.02 s, midpoint energy) against the 300 Hz rapier flight: within 2 %
     // (the bound of the flight core's 20 random trajectories), and the same duration to a few
     // ticks (the run ends on the tick the UAV arrives, the rollout on its 0.02 s grid).
     let error = predicted.energy_j / energy - 1.0;
-    assert!(error.abs() < 0.02, "rollout {predicted:?} vs flown {energy} J");
+    eprintln!(
+        "rollout {:.1} J in {:.3} s, flown {energy:.1} J in {:.3} s: {:+.3} %",
+        predicted.energy_j,
+        predicted.duration_s,
+        flown.mission_time_s,
+        100.0 * error
+    );
+    assert!(
+        error.abs() < 0.02,
+        "rollout {predicted:?} vs flown {energy} J"
+    );
     assert!(
         (predicted.duration_s - flown.mission_time_s).abs() < 0.05,
         "{} vs {}",

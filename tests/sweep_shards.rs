@@ -93,7 +93,7 @@ fn merge_reports_missing_runs_and_conflicts() {
     std::fs::write(&tampered, serde_json::to_string(&value).unwrap()).unwrap();
 
     let merged = tmp.path().join("merged");
-    let report = merge(&merged, &[one.clone()]).unwrap();
+    let report = merge(&merged, std::slice::from_ref(&one)).unwrap();
     assert_eq!(report.copied, 3);
     let missing: Vec<&String> = runs
         .iter()
@@ -153,7 +153,7 @@ fn plots_are_drawn_from_a_results_folder() {
     let svg = std::fs::read_to_string(out.join("plots/exploration_rate.svg")).unwrap();
     assert!(svg.contains("Exploration rate: room, by speed"), "title");
     assert!(
-        svg.contains(">0.5<") && svg.contains(">2.0<"),
+        svg.contains("\n0.5\n</text>") && svg.contains("\n2.0\n</text>"),
         "legend labels"
     );
 }

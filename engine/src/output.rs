@@ -178,3 +178,53 @@ pub fn uav_series_csv(rows: &[UavRow]) -> String {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(uav: &str, power_w: Option<f64>, rotor_speeds: Option<[f32; 4]>) -> UavRow {
+        UavRow {
+            time_s: 0.5,
+            uav: uav.to_owned(),
+            x: 1.0,
+            y: 2.0,
+            z: 3.0,
+            yaw: 0.25,
+            speed: 1.5,
+            path_length_m: 4.0,
+            power_w,
+            rotor_speeds,
+        }
+    }
+
+    #[test]
+    fn uav_series_has_power_and_rotor_speeds_or_empty_cells() {
+        let csv = uav_series_csv(&[
+            row(
+                "dynamic",
+                Some(123.5),
+                Some([1000.0, 1001.0, 1002.0, 1003.5]),
+            ),
+            row("kinematic", None, None),
+        ]);
+        let lines: Vec<&str> = csv.lines().collect();
+        assert_eq!(
+            lines,
+            [
+                "time_s,uav,x,y,z,yaw,speed,path_length_m,power_w,\
+                 rotor_speed_0,rotor_speed_1,rotor_speed_2,rotor_speed_3",
+                "0.5,dynamic,1,2,3,0.25,1.5,4,123.5,1000,1001,1002,1003.5",
+                "0.5,kinematic,1,2,3,0.25,1.5,4,,,,,",
+            ]
+        );
+    }
+
+    #[test]
+    fn kinematic_uavs_have_null_energy() {
+        let summary = UavSummary::new("k".into(), 2.0, "finished".into(), None, None);
+        let json = serde_json::to_value(&summary).unwrap();
+        assert!(json["energy_j"].is_null() && json["battery_soc_end"].is_null());
+        assert!(json["ended_position"].is_null());
+    }
+}

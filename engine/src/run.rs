@@ -94,10 +94,7 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
     uavs.sort_by_key(|(index, ..)| *index);
     let energies: Vec<&EnergySummary> = uavs.iter().filter_map(|u| u.3.as_ref()).collect();
     let energy_j = (!energies.is_empty()).then(|| energies.iter().map(|e| e.energy_j).sum());
-    let battery_soc_end = energies
-        .iter()
-        .map(|e| e.battery_soc_end)
-        .reduce(f64::min);
+    let battery_soc_end = energies.iter().map(|e| e.battery_soc_end).reduce(f64::min);
     let mut record = world.resource_mut::<RunRecord>();
     record.close(time_s, metrics);
     let record = world.resource::<RunRecord>();

@@ -1,9 +1,7 @@
 //! The simulation of one run: a bevy `World` built from one scenario and one seed, and the
 //! `Tick` schedule with the pipeline stages (DESIGN.md "One tick").
 
-use crate::flight::{
-    Physics, airframe_of, end_on_empty_battery, step_physics, waypoint_flight,
-};
+use crate::flight::{Physics, airframe_of, end_on_empty_battery, step_physics, waypoint_flight};
 use crate::metrics::{RunRecord, record_metrics};
 use crate::scenario::{BehaviourSpec, LoadedScenario, ScenarioErrors};
 use crate::world::{build_world, check_starts_with_radii, sensor_bundle};

@@ -5,20 +5,27 @@
 //! fitting ([`report`]). The planner and the energy model themselves live in
 //! [`uavex_systems::coverage`].
 
+pub mod calibrate;
 pub mod field;
+pub mod flight;
 pub mod measurements;
 pub mod model_io;
 pub mod outputs;
 pub mod picture;
+pub mod profile;
 pub mod report;
+pub mod scenario;
 pub mod spec;
 
+pub use calibrate::{Calibration, CalibrationPlan, LegCheck, calibrate, check_legs};
 pub use field::{Coordinates, Field, LocalProjection, read_field};
+pub use flight::{FlownProfile, PlanComparison, fly_plan, fly_profile, plan_profile};
 pub use measurements::{fit_measurements, read_measurements, write_measurements};
 pub use model_io::{load_energy_model, save_fitted_model};
 pub use outputs::{PlanFiles, write_geojson, write_legs_csv, write_plan, write_waypoints_csv};
 pub use picture::write_picture;
 pub use report::{cover_report, energy_report, fit_report};
+pub use scenario::{CoverageScenario, read_coverage_scenario};
 pub use spec::{AreaSpec, CoverageSetup, CoverageSpec};
 
 use std::path::PathBuf;
@@ -51,4 +58,7 @@ pub enum CoverageIoError {
     Picture { path: PathBuf, message: String },
     #[error(transparent)]
     Mission(#[from] MissionError),
+    /// A simulated flight (calibration or flying a plan) failed.
+    #[error("simulated flight: {0}")]
+    Flight(String),
 }

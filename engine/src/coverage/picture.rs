@@ -26,7 +26,9 @@ pub fn write_picture(
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
     let drawn = match extension.as_deref() {
-        Some("png") => scene.draw(&BitMapBackend::new(file, size).into_drawing_area()),
+        Some("png") => png_bytes(&scene, size).and_then(|bytes| {
+            std::fs::write(file, bytes).map_err(|e| format!("cannot write: {e}"))
+        }),
         Some("svg") => scene.draw(&SVGBackend::new(file, size).into_drawing_area()),
         _ => Err("the picture's file name must end in .png or .svg".to_owned()),
     };
@@ -34,6 +36,14 @@ pub fn write_picture(
         path: file.to_owned(),
         message,
     })
+}
+
+/// The scene rendered into an RGB buffer and encoded with the plots' PNG encoder (plotters'
+/// own file encoder would pull in the `image` crate).
+fn png_bytes(scene: &Scene, (w, h): (u32, u32)) -> Result<Vec<u8>, String> {
+    let mut pixels = vec![0u8; (w as usize) * (h as usize) * 3];
+    scene.draw(&BitMapBackend::with_buffer(&mut pixels, (w, h)).into_drawing_area())?;
+    crate::plot::draw::encode_png(&pixels, w, h).map_err(|e| e.to_string())
 }
 
 /// The plan's geometry and the mapping from metres to pixels (y up in the world, down in the

@@ -14,8 +14,8 @@ use uavex_components::uav::QuadState;
 use uavex_components::world::WorldGeometry;
 use uavex_systems::behaviour::waypoints::{CLEARANCE_MARGIN_M, WaypointTour, plan_tour};
 use uavex_systems::flight::{
-    Completion, ControllerGains, FlightController, FlightEnergy, FlightState,
-    GeometricController, ReferenceTrajectory, RotorCommands,
+    Completion, ControllerGains, FlightController, FlightEnergy, FlightState, GeometricController,
+    ReferenceTrajectory, RotorCommands,
 };
 use uavex_systems::trajectory::PlanError;
 
@@ -105,8 +105,8 @@ pub fn waypoint_flight(
         yaw,
         collision_check,
     )?;
-    let controller = GeometricController::new(airframe, ControllerGains::default())
-        .ok_or_else(|| {
+    let controller =
+        GeometricController::new(airframe, ControllerGains::default()).ok_or_else(|| {
             BuildError::new(
                 format!("uav[{index}].airframe_overrides"),
                 "the rotor layout cannot be mixed into thrust and torques",
@@ -168,7 +168,8 @@ pub fn plan_waypoints(
 fn plan_error(index: usize, clearance: f64, error: PlanError) -> BuildError {
     let behaviour = format!("uav[{index}].behaviour");
     let waypoint = |k: usize| format!("{behaviour}.waypoints[{k}]");
-    let near = format!("within {clearance:.2} m (the airframe's radius and a margin) of an obstacle");
+    let near =
+        format!("within {clearance:.2} m (the airframe's radius and a margin) of an obstacle");
     match error {
         PlanError::StartBlocked => BuildError::new(
             format!("uav[{index}].start.position"),
@@ -225,8 +226,8 @@ mod tests {
         let airframe = airframe_of(&uav("iris", &[("mass", 1.5)]), 0).unwrap();
         assert_eq!((airframe.name.as_str(), airframe.mass), ("iris", 1.5));
 
-        let errors = airframe_of(&uav("kingfisher", &[("wieght", 1.0), ("mass", 0.8)]), 2)
-            .unwrap_err();
+        let errors =
+            airframe_of(&uav("kingfisher", &[("wieght", 1.0), ("mass", 0.8)]), 2).unwrap_err();
         assert_eq!(errors.len(), 1);
         assert_eq!(errors[0].path, "uav[2].airframe_overrides.wieght");
         assert!(errors[0].message.contains("mass"), "{}", errors[0].message);

@@ -156,11 +156,7 @@ pub fn end_on_empty_battery(
         let reason = format!(
             "UAV '{}' drew the usable {:.0} J of its battery at t = {time_s:.3} s at \
              ({:.3}, {:.3}, {:.3})",
-            uav.name,
-            energy.battery.usable_j,
-            state.position.x,
-            state.position.y,
-            state.position.z
+            uav.name, energy.battery.usable_j, state.position.x, state.position.y, state.position.z
         );
         if first_empty.as_ref().is_none_or(|(i, _)| uav.index < *i) {
             first_empty = Some((uav.index, reason));

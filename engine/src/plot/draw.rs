@@ -106,7 +106,8 @@ pub fn render_rgb(figure: &impl Figure, (w, h): (u32, u32)) -> Result<Vec<u8>, P
     Ok(pixels)
 }
 
-fn encode_png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, PlotError> {
+/// 8-bit RGB pixels (row by row) as PNG bytes, with the `png` crate (no `image` crate).
+pub fn encode_png(rgb: &[u8], w: u32, h: u32) -> Result<Vec<u8>, PlotError> {
     let mut bytes = Vec::new();
     let mut encoder = png::Encoder::new(&mut bytes, w, h);
     encoder.set_color(png::ColorType::Rgb);

@@ -18,7 +18,7 @@ impl Curve {
     /// The value at `t`: the last sample at or before `t`, the first sample before it starts.
     pub fn value_at(&self, t: f64) -> Option<f64> {
         let after = self.times.partition_point(|&s| s <= t);
-        let at = after.checked_sub(1).unwrap_or(0);
+        let at = after.saturating_sub(1);
         self.values.get(at).copied()
     }
 

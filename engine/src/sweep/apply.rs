@@ -7,7 +7,7 @@
 
 use super::path::{OverridePath, Step};
 use thiserror::Error;
-use toml_edit::{DocumentMut, Item, Table, Value};
+use toml_edit::{DocumentMut, Item, Value};
 
 /// One value to put at one place of a scenario.
 #[derive(Debug, Clone, PartialEq)]
@@ -150,7 +150,7 @@ fn put(parent: &mut Item, step: &Step, value: Value) -> Result<(), String> {
                 let slot = list
                     .get_mut(*index)
                     .ok_or_else(|| out_of_range(*index, len))?;
-                *slot = Table::from(table);
+                *slot = table;
                 Ok(())
             }
             Item::Value(Value::Array(list)) => {

@@ -55,9 +55,7 @@ pub fn follow_headings(start: DVec3, start_yaw: f64, waypoints: &[DVec3]) -> Vec
             (Some(a), Some(l)) => Some(a + l).filter(|s| s.length() > 1e-6),
             (a, l) => a.or(l),
         };
-        let heading = bisector
-            .or(arriving)
-            .map_or(previous, |d| d.y.atan2(d.x));
+        let heading = bisector.or(arriving).map_or(previous, |d| d.y.atan2(d.x));
         headings.push(heading);
         previous = heading;
     }

@@ -5,19 +5,37 @@
 //! The segment is first clipped to the map's key box (slab test), so the traversal itself never
 //! checks bounds. The walk then takes exactly `|Δkey|_1` steps, one axis at a time, always the
 //! axis whose next boundary the segment crosses first; an axis that has reached the end key
-//! is retired. This makes the walk end exactly on the end key whatever the floating-point
-//! rounding, and the path is 6-connected (a ray through an edge or corner visits one of the
-//! voxels beside it too, which is conservative for free space).
+//! is retired. This makes the walk end exactly on the end key whatever the rounding, and the
+//! path is 6-connected (a ray through an edge or corner visits one of the voxels beside it too,
+//! which is conservative for free space).
+//!
+//! Boundary times (the segment parameter, 0 at the start, 1 at the end, at which the next
+//! boundary on an axis is crossed) are fixed-point integers in units of 1 / [`T_ONE`]: the map
+//! update's inner loop chooses the axis with integer compares and masks, whose step-to-step
+//! latency is a third of floating point's, and every traversal here uses the same numbers, so
+//! all break exact ties (rays through edges and corners) the same way.
 
 use glam::{DVec3, IVec3};
 use uavex_components::map::floor_to_key;
 
-/// Stand-in for "never" in the boundary times of retired axes.
-const NEVER: f64 = f64::INFINITY;
-/// Cap on finite boundary times: an axis the segment barely moves along gets huge but finite
-/// times, so even after 2^37 steps its time stays below [`NEVER`] and the walk always picks an
-/// axis that still has steps left.
-const TIME_CAP: f64 = 1e290;
+/// Fixed-point one of the segment parameter: 2^44. A boundary time or interval is truncated by
+/// less than 6e-14; after 2^20 steps the accumulated error is below 6e-8.
+pub const T_ONE: f64 = (1u64 << 44) as f64;
+/// Largest boundary time or interval of an axis with steps left (2^16 segment lengths, far
+/// past any segment's end): two of them add up to 2^61, far from overflow.
+const T_CAP: i64 = 1 << 60;
+/// Boundary time of an axis with no step left: later than any axis with steps left.
+pub const T_RETIRED: i64 = i64::MAX;
+
+/// A segment parameter in fixed point, saturating at [`T_CAP`].
+#[inline]
+pub fn to_fixed(t: f64) -> i64 {
+    if t < T_CAP as f64 / T_ONE {
+        (t * T_ONE) as i64
+    } else {
+        T_CAP
+    }
+}
 
 /// A segment clipped to a key box: the keys it starts and ends in.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -81,9 +99,9 @@ pub struct VoxelWalk {
     /// `match`, i.e. a mispredicted branch per step).
     key: [i32; 3],
     /// Segment parameter at which the next boundary on each axis is crossed.
-    t_max: [f64; 3],
+    t_max: [i64; 3],
     /// Parameter increment between boundaries on each axis (1 / |d|).
-    t_delta: [f64; 3],
+    t_delta: [i64; 3],
     step: [i32; 3],
     remaining: [u32; 3],
 }
@@ -95,8 +113,8 @@ impl VoxelWalk {
         let d = end - start;
         let mut walk = Self {
             key: start_key.to_array(),
-            t_max: [NEVER; 3],
-            t_delta: [NEVER; 3],
+            t_max: [T_RETIRED; 3],
+            t_delta: [0; 3],
             step: [0; 3],
             remaining: [0; 3],
         };
@@ -108,8 +126,9 @@ impl VoxelWalk {
             let boundary = f64::from(start_key[axis] + i32::from(n > 0));
             walk.step[axis] = n.signum();
             walk.remaining[axis] = n.unsigned_abs();
-            walk.t_max[axis] = ((boundary - start[axis]) / d[axis]).min(TIME_CAP);
-            walk.t_delta[axis] = (1.0 / d[axis].abs()).min(TIME_CAP);
+            let inverse = 1.0 / d[axis];
+            walk.t_max[axis] = to_fixed((boundary - start[axis]) * inverse);
+            walk.t_delta[axis] = to_fixed(inverse.abs());
         }
         walk
     }
@@ -131,27 +150,27 @@ impl VoxelWalk {
         self.step
     }
 
-    /// Segment parameter of the next boundary on each axis (infinite for axes with no step
-    /// left).
+    /// Fixed-point segment parameter of the next boundary on each axis ([`T_RETIRED`] for
+    /// axes with no step left).
     #[inline]
-    pub fn boundary_times(&self) -> [f64; 3] {
+    pub fn boundary_times(&self) -> [i64; 3] {
         self.t_max
     }
 
-    /// Segment parameter between two boundaries on each axis.
+    /// Fixed-point segment parameter between two boundaries on each axis.
     #[inline]
-    pub fn boundary_intervals(&self) -> [f64; 3] {
+    pub fn boundary_intervals(&self) -> [i64; 3] {
         self.t_delta
     }
 
     /// Continues the walk at `key` with next boundary times `t_max`, after a caller's own loop
     /// (see `integrate`) took steps along the walk's axes without bookkeeping of their counts.
-    pub fn resume(&mut self, key: IVec3, t_max: [f64; 3]) {
+    pub fn resume(&mut self, key: IVec3, t_max: [i64; 3]) {
         for axis in 0..3 {
             let taken = (key[axis] - self.key[axis]).unsigned_abs();
             self.remaining[axis] = self.remaining[axis].saturating_sub(taken);
             self.t_max[axis] = if self.remaining[axis] == 0 {
-                NEVER
+                T_RETIRED
             } else {
                 t_max[axis]
             };
@@ -162,10 +181,8 @@ impl VoxelWalk {
     /// Moves to the next voxel; returns which axis it moved along (exactly one is `true`).
     /// Only meaningful while [`Self::steps_left`] > 0.
     ///
-    /// The axis is the one with the earliest boundary (ties go to x, then y, then z). Which
-    /// axis comes next is as good as random, so it is chosen with comparisons and selects on
-    /// all three axes rather than a branch (mispredicted about every other step) or an index
-    /// by a run-time axis (which would keep the walk's state in memory instead of registers).
+    /// The axis is the one with the earliest boundary; ties go to x, then y, then z (the map
+    /// update's inner loop decides the same way).
     #[inline(always)]
     pub fn advance(&mut self) -> [bool; 3] {
         let t = self.t_max;
@@ -177,11 +194,11 @@ impl VoxelWalk {
             let remaining = self.remaining[axis].saturating_sub(u32::from(m));
             self.remaining[axis] = remaining;
             let next = if m {
-                t[axis] + self.t_delta[axis]
+                t[axis].saturating_add(self.t_delta[axis])
             } else {
                 t[axis]
             };
-            self.t_max[axis] = if remaining == 0 { NEVER } else { next };
+            self.t_max[axis] = if remaining == 0 { T_RETIRED } else { next };
             self.key[axis] += if m { self.step[axis] } else { 0 };
         }
         moved

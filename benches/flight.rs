@@ -1,5 +1,6 @@
-//! Flight benchmarks: physics + control steps per second for one UAV on rapier, and offline
-//! rollouts per second of a 10 s trajectory at the EAAE step of 0.02 s.
+//! Flight benchmarks: physics + control steps per second for one UAV on rapier, offline
+//! rollouts per second of a 10 s trajectory at the EAAE step of 0.02 s, and whole-run ticks per
+//! second of a dynamic UAV's waypoint tour.
 //!
 //! Run: `cargo bench --bench flight`. Figures are reported in the README.
 
@@ -9,8 +10,10 @@ use rapier3d::prelude::{Pose, Rotation, SharedShape, Vector};
 use std::f32::consts::{FRAC_PI_2, PI};
 use std::hint::black_box;
 use uavex_components::airframe::Airframe;
+use uavex_components::sim::{Outcome, SimClock};
 use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
 use uavex_engine::physics::{FlightWorld, FlightWorldConfig, UavHandle, UavStatus};
+use uavex_engine::sim::Sim;
 use uavex_systems::flight::{
     ControllerGains, FlightState, GeometricController, RolloutConfig, rollout, rollout_batch,
 };
@@ -198,5 +201,29 @@ fn rollouts(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, physics_and_control, rollouts);
+/// The whole tick of a run (every stage's systems, the ECS, the physics) on the shipped
+/// waypoint tour of the Pillars scene with its camera taken off, build included, in ticks per
+/// second: what a dynamic UAV costs a run besides its sensing and mapping.
+fn whole_run(c: &mut Criterion) {
+    let mut loaded = uavex_engine::scenario::load("scenarios/pillars_waypoints.toml").unwrap();
+    loaded.scenario.uavs[0].sensors.clear();
+    let ticks = {
+        let mut sim = Sim::build(&loaded, loaded.scenario.seed).unwrap();
+        let (outcome, reason) = sim.run_to_end();
+        assert_eq!(outcome, Outcome::Complete, "{reason}");
+        sim.world.resource::<SimClock>().tick
+    };
+    let mut group = c.benchmark_group("run");
+    group.throughput(Throughput::Elements(ticks));
+    group.sample_size(10);
+    group.bench_function("pillars_waypoints_ticks_without_camera", |b| {
+        b.iter(|| {
+            let mut sim = Sim::build(&loaded, loaded.scenario.seed).unwrap();
+            black_box(sim.run_to_end())
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, physics_and_control, rollouts, whole_run);
 criterion_main!(benches);

@@ -125,3 +125,40 @@ fn calibrate_writes_a_model_that_energy_reads() {
         stdout(&output)
     );
 }
+
+/// `uavex run` flies the coverage behaviour on the true quadrotor in the ECS: its summary's
+/// energy is within 5 % of the plan's prediction (eq. 18) with the calibrated model.
+#[test]
+fn run_flies_the_coverage_scenario_as_predicted() {
+    let dir = tempfile::tempdir().unwrap();
+    let output = uavex(&[
+        "run",
+        "scenarios/coverage_field.toml",
+        "--out",
+        dir.path().to_str().unwrap(),
+    ]);
+    assert!(output.status.success(), "{output:?}");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("summary.json")).unwrap())
+            .unwrap();
+    let scenario = uavex_engine::coverage::read_coverage_scenario(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/coverage_field.toml"),
+    )
+    .unwrap();
+    let setup = scenario
+        .spec
+        .resolve(scenario.base_dir(), &scenario.path)
+        .unwrap();
+    let predicted = setup.plan().unwrap().plan;
+    let flown_energy = summary["energy_j"].as_f64().unwrap();
+    let flown_time = summary["mission_time_s"].as_f64().unwrap();
+    assert_eq!(summary["reason"], "every UAV completed its behaviour");
+    assert!(
+        (flown_energy / predicted.energy_j - 1.0).abs() < 0.05,
+        "{summary}"
+    );
+    assert!(
+        (flown_time / predicted.time_s - 1.0).abs() < 0.05,
+        "{summary}"
+    );
+}

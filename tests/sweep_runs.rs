@@ -181,3 +181,69 @@ fn failing_runs_are_recorded_and_the_others_go_on() {
         "bad resolutions fail again"
     );
 }
+
+#[test]
+fn the_command_line_runs_shards_merges_and_plots() {
+    let tmp = tempfile::tempdir().unwrap();
+    plan_in(tmp.path(), SPEEDS);
+    let uavex = |args: &[&str]| {
+        let output = std::process::Command::new(env!("CARGO_BIN_EXE_uavex"))
+            .args(args)
+            .current_dir(tmp.path())
+            .output()
+            .unwrap();
+        let text = String::from_utf8_lossy(&output.stdout).into_owned()
+            + &String::from_utf8_lossy(&output.stderr);
+        (output.status.code(), text)
+    };
+    for shard in ["1/2", "2/2"] {
+        let out = format!("s{}", &shard[..1]);
+        let (code, text) = uavex(&[
+            "sweep",
+            "plan.toml",
+            "--out",
+            &out,
+            "--shard",
+            shard,
+            "--jobs",
+            "2",
+        ]);
+        assert_eq!(code, Some(0), "{text}");
+        assert!(
+            text.contains(&format!(
+                "sweep test (shard {shard}): 3 runs, 0 finished before, 3 ran"
+            )),
+            "{text}"
+        );
+    }
+    let (code, text) = uavex(&["merge", "--out", "all", "s1", "s2"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(
+        text.contains("6 runs copied, 0 already there, 0 conflicting, 0 missing"),
+        "{text}"
+    );
+    for file in [
+        "runs.csv",
+        "runs.parquet",
+        "summary.csv",
+        "summary.md",
+        "plots/exploration_rate.svg",
+    ] {
+        assert!(tmp.path().join("all").join(file).is_file(), "{file}");
+    }
+    std::fs::remove_dir_all(tmp.path().join("all/plots")).unwrap();
+    let (code, text) = uavex(&["plot", "all"]);
+    assert_eq!(code, Some(0), "{text}");
+    assert!(tmp.path().join("all/plots/exploration_rate.png").is_file());
+
+    // A plan that cannot be read is refused with exit code 2 and the reason.
+    std::fs::write(tmp.path().join("bad.toml"), "seeds = 1\n").unwrap();
+    let (code, text) = uavex(&["sweep", "bad.toml", "--out", "x"]);
+    assert_eq!(code, Some(2));
+    assert!(
+        text.contains("bad.toml: the plan names no scenario"),
+        "{text}"
+    );
+    let (code, _) = uavex(&["sweep", "plan.toml", "--out", "x", "--shard", "3/2"]);
+    assert_eq!(code, Some(2), "clap refuses a shard out of range");
+}

@@ -70,10 +70,12 @@ impl Sim {
         if !start_problems.is_empty() {
             return Err(locate(start_problems));
         }
-        let dynamic = scenario
-            .uavs
-            .iter()
-            .any(|u| matches!(u.behaviour, BehaviourSpec::Waypoints { .. }));
+        let dynamic = scenario.uavs.iter().any(|u| {
+            matches!(
+                u.behaviour,
+                BehaviourSpec::Waypoints { .. } | BehaviourSpec::Coverage(_)
+            )
+        });
         let mut physics = if dynamic {
             let physics = Physics::new(&geometry, 1.0 / scenario.physics_rate_hz)
                 .map_err(|e| loaded.errors([("physics_rate_hz", e.to_string())]))?;
@@ -128,29 +130,49 @@ impl Sim {
                         next: 0,
                     });
                 }
+                BehaviourSpec::Coverage(coverage) => {
+                    let Some(physics) = physics.as_mut() else {
+                        continue;
+                    };
+                    match crate::coverage::behaviour::coverage_flight(
+                        spec,
+                        index,
+                        airframe,
+                        physics,
+                        coverage,
+                        &loaded.base_dir,
+                        &loaded.path,
+                    ) {
+                        Ok(flight) => {
+                            world.entity_mut(uav).insert(flight);
+                        }
+                        Err(e) => problems.push(e),
+                    }
+                }
                 BehaviourSpec::Waypoints {
                     waypoints,
                     yaw,
                     collision_check,
                 } => {
                     // `dynamic` made the physics for exactly this case.
-                    let Some(physics) = physics.as_mut() else {
-                        continue;
-                    };
-                    match waypoint_flight(
-                        spec,
-                        index,
-                        airframe,
-                        world.resource::<WorldGeometry>(),
-                        physics,
-                        waypoints,
-                        yaw.as_deref(),
-                        *collision_check,
-                    ) {
-                        Ok(flight) => {
+                    let flight = physics.as_mut().map(|physics| {
+                        waypoint_flight(
+                            spec,
+                            index,
+                            airframe,
+                            world.resource::<WorldGeometry>(),
+                            physics,
+                            waypoints,
+                            yaw.as_deref(),
+                            *collision_check,
+                        )
+                    });
+                    match flight {
+                        Some(Ok(flight)) => {
                             world.entity_mut(uav).insert(flight);
                         }
-                        Err(e) => problems.push(e),
+                        Some(Err(e)) => problems.push(e),
+                        None => {}
                     }
                 }
             }

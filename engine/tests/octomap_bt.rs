@@ -36,8 +36,13 @@ fn block(min: [i32; 3], side: i32, occupied: bool, out: &mut BTreeMap<[i32; 3], 
     }
 }
 
-/// The voxel set, and the leaves OctoMap must hold for it (depth, occupied, min corner).
-fn scene() -> (BTreeMap<[i32; 3], bool>, BTreeSet<(u8, bool, [i32; 3])>) {
+/// Voxel key -> occupied.
+type Voxels = BTreeMap<[i32; 3], bool>;
+/// Octree leaves as (depth, occupied, min corner).
+type Leaves = BTreeSet<(u8, bool, [i32; 3])>;
+
+/// The voxel set, and the leaves OctoMap must hold for it.
+fn scene() -> (Voxels, Leaves) {
     let mut voxels = BTreeMap::new();
     let mut leaves = BTreeSet::new();
     // Aligned blocks prune: side 8 -> depth 13, side 4 -> depth 14, side 2 -> depth 15.

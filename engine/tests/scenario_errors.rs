@@ -146,7 +146,7 @@ fn unknown_kinds_name_what_this_build_knows() {
         "uav[0].behaviour.kind",
         18,
         8,
-        "unknown behaviour 'eaae' for uav[0]: this build knows: scripted, waypoints",
+        "unknown behaviour 'eaae' for uav[0]: this build knows: scripted, waypoints, coverage",
     );
     assert_only(
         &with("kind = \"depth_camera\"", "kind = \"depth-camera\""),
@@ -194,7 +194,7 @@ fn missing_fields_point_at_their_table() {
         "uav[0].behaviour.kind",
         17,
         1,
-        "required field is missing; this build knows: scripted, waypoints",
+        "required field is missing; this build knows: scripted, waypoints, coverage",
     );
     assert_only(
         &with("time_limit_s = 60.0", ""),
@@ -304,7 +304,7 @@ behaviour = { kind = "explore" }
         (
             36,
             "uav[1].behaviour.kind",
-            "unknown behaviour 'explore' for uav[1]: this build knows: scripted, waypoints",
+            "unknown behaviour 'explore' for uav[1]: this build knows: scripted, waypoints, coverage",
         ),
         // Meaning, of every piece that decoded, in file order.
         (

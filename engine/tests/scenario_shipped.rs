@@ -37,6 +37,15 @@ fn load_shipped(name: &str) -> LoadedScenario {
     load(scenarios_dir().join(name)).unwrap_or_else(|e| panic!("{name}:\n{e}"))
 }
 
+/// The airborne scenes of this issue: their UAVs start in the air, clear of everything.
+const AIRBORNE: &[&str] = &[
+    "eaae_simple.toml",
+    "eaae_pillars.toml",
+    "pillars_scripted.toml",
+    "all_obstacles.toml",
+    "lidar.toml",
+];
+
 #[test]
 fn every_shipped_scenario_loads_and_builds_its_world() {
     let files = shipped();
@@ -44,20 +53,14 @@ fn every_shipped_scenario_loads_and_builds_its_world() {
         .iter()
         .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
         .collect();
-    for expected in [
-        "eaae_simple.toml",
-        "eaae_pillars.toml",
-        "pillars_scripted.toml",
-        "all_obstacles.toml",
-        "lidar.toml",
-    ] {
+    for expected in AIRBORNE {
         assert!(
             names.iter().any(|n| n == expected),
             "{expected} missing from {names:?}"
         );
     }
-    for file in files {
-        let loaded = load(&file).unwrap_or_else(|e| panic!("{}:\n{e}", file.display()));
+    for (file, name) in files.iter().zip(&names) {
+        let loaded = load(file).unwrap_or_else(|e| panic!("{}:\n{e}", file.display()));
         let starts: Vec<Vec3> = loaded
             .scenario
             .uavs
@@ -71,8 +74,12 @@ fn every_shipped_scenario_loads_and_builds_its_world() {
             &loaded.base_dir,
         )
         .unwrap_or_else(|errors| panic!("{}: {errors:?}", file.display()));
-        let inside = check_starts(&world, &starts, 0.25);
-        assert!(inside.is_empty(), "{}: {inside:?}", file.display());
+        // A UAV's ball of 0.25 m (the kingfisher's arms reach 0.125 m) is clear of everything;
+        // scenes of other issues may start on the ground and are left to their own tests.
+        if AIRBORNE.contains(&name.as_str()) {
+            let inside = check_starts(&world, &starts, 0.25);
+            assert!(inside.is_empty(), "{}: {inside:?}", file.display());
+        }
     }
 }
 

@@ -9,8 +9,8 @@ use bevy_ecs::prelude::*;
 use glam::{DVec3, IVec3, Vec3};
 
 /// Largest map, in voxels of the bounding box (2^36, e.g. 1 km x 1 km x 68 m at 0.1 m; memory
-/// for the touched chunks runs out long before). It keeps the fixed-point statistics far from overflow (see
-/// [`super::STAT_ONE`]) and the chunk index small.
+/// for the touched chunks runs out long before). It keeps the fixed-point statistics far from
+/// overflow (see [`super::STAT_ONE`]) and the chunk index small.
 pub const MAX_BOX_VOXELS: u64 = 1 << 36;
 /// Largest chunk grid (entries of the dense [`super::ChunkIndex`]: 128 MiB at 8 bytes each).
 const MAX_CHUNKS: u64 = 1 << 24;

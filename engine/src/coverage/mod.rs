@@ -2,9 +2,13 @@
 //! users' fields from GeoJSON and WKT ([`field`]), measurement logs as CSV ([`measurements`]),
 //! energy models by preset name or file ([`model_io`]), and the plan written as CSV, GeoJSON and
 //! a picture ([`outputs`], [`picture`]) with text reports for `uavex energy`, `uavex cover` and
-//! fitting ([`report`]). The planner and the energy model themselves live in
+//! fitting ([`report`]). The coverage UAV of a scenario file ([`scenario`]); the model's motions
+//! as a trajectory ([`profile`]) flown on the true quadrotor ([`flight`]: calibration logs and
+//! predicted against flown energy), the paper's calibration experiments ([`mod@calibrate`]) and the
+//! behaviour in `uavex run` ([`behaviour`]). The planner and the energy model themselves live in
 //! [`uavex_systems::coverage`].
 
+pub mod behaviour;
 pub mod calibrate;
 pub mod field;
 pub mod flight;

@@ -22,7 +22,7 @@ use super::model_io::load_energy_model;
 use super::outputs::{PlanFiles, write_plan};
 use super::report::cover_report;
 use glam::DVec2;
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use uavex_systems::coverage::{
     AltitudeOutcome, AltitudeSearch, Camera, CoverageProblem, Overlaps, Polygon, ScanDirection,
@@ -30,7 +30,7 @@ use uavex_systems::coverage::{
 };
 
 /// What a coverage mission surveys, with what, and on how much energy.
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct CoverageSpec {
     pub area: AreaSpec,
@@ -53,7 +53,7 @@ pub struct CoverageSpec {
 }
 
 /// The field: vertices in metres, or a GeoJSON/WKT file (exactly one of the two).
-#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct AreaSpec {
     #[serde(default)]

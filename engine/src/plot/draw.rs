@@ -207,9 +207,21 @@ impl Figure for BandFigure {
                     PathElement::new(vec![(x, y), (x + 18, y)], c.stroke_width(2))
                 });
         }
+        // The legend goes in the right-hand corner the curves end away from.
+        let ends: Vec<f64> = p
+            .groups
+            .iter()
+            .filter_map(|(_, b)| b.mean.last().copied())
+            .collect();
+        let end_mean = ends.iter().sum::<f64>() / ends.len().max(1) as f64;
+        let corner = if end_mean < (y0 + y1) / 2.0 {
+            SeriesLabelPosition::UpperRight
+        } else {
+            SeriesLabelPosition::LowerRight
+        };
         chart
             .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
+            .position(corner)
             .background_style(WHITE.mix(0.85))
             .border_style(BLACK.mix(0.4))
             .label_font(("sans-serif", 12))

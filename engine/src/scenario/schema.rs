@@ -305,6 +305,9 @@ pub enum BehaviourSpec {
         #[serde(default = "defaults::yes")]
         collision_check: bool,
     },
+    /// Energy-aware coverage of a polygon with a nadir camera (coverage.md): planned by
+    /// `uavex cover`, which also flies the plan on the true quadrotor with `--fly`.
+    Coverage(crate::coverage::CoverageSpec),
 }
 
 /// What a run writes besides `summary.json`.

@@ -183,7 +183,8 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
             bar.inc(1);
         });
     });
-    bar.finish();
+    // The report printed after the sweep says what the bar said.
+    bar.finish_and_clear();
 
     let mut failed = failed.into_inner().unwrap_or_else(|e| e.into_inner());
     failed.sort();

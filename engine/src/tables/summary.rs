@@ -57,10 +57,14 @@ impl FieldStats {
         if n == 0 {
             return None;
         }
-        let mean = values.iter().sum::<f64>() / n as f64;
+        // Shifted by the first value: equal values give exactly zero spread, and large
+        // offsets (voxel counts) lose no precision.
+        let shift = values[0];
+        let sum: f64 = values.iter().map(|v| v - shift).sum();
+        let mean = shift + sum / n as f64;
         let std = (n >= 2).then(|| {
-            let squares: f64 = values.iter().map(|v| (v - mean).powi(2)).sum();
-            (squares / (n - 1) as f64).sqrt()
+            let squares: f64 = values.iter().map(|v| (v - shift).powi(2)).sum();
+            ((squares - sum * sum / n as f64).max(0.0) / (n - 1) as f64).sqrt()
         });
         Some(Self {
             field: field.to_owned(),
@@ -202,13 +206,14 @@ pub fn to_csv(table: &SummaryTable) -> Result<Vec<u8>, csv::Error> {
         .map_err(|e| csv::Error::from(std::io::Error::other(e.to_string())))
 }
 
-/// A number with four significant digits (scientific beyond 1e5 or below 1e-3).
+/// A number with four significant digits, all integer digits kept up to 1e9 (voxel counts),
+/// scientific beyond or below 1e-3.
 pub fn format_number(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {
         return format!("{x}");
     }
     let magnitude = x.abs().log10().floor() as i32;
-    if !(-3..5).contains(&magnitude) {
+    if !(-3..9).contains(&magnitude) {
         return format!("{x:.3e}");
     }
     let decimals = (3 - magnitude).max(0) as usize;
@@ -376,6 +381,14 @@ mod tests {
     }
 
     #[test]
+    fn equal_values_have_no_spread() {
+        let s = FieldStats::of("x", &[56.233333333333334; 3]).unwrap();
+        assert_eq!((s.mean, s.std), (56.233333333333334, Some(0.0)));
+        let big = FieldStats::of("x", &[1e9 + 1.0, 1e9 + 3.0]).unwrap();
+        assert_eq!((big.mean, big.std), (1e9 + 2.0, Some(2f64.sqrt())));
+    }
+
+    #[test]
     fn csv_has_one_row_per_group() {
         let csv = String::from_utf8(to_csv(&summarise(&rows())).unwrap()).unwrap();
         let lines: Vec<&str> = csv.lines().collect();
@@ -414,7 +427,8 @@ mod tests {
         assert_eq!(format_number(0.92346), "0.9235");
         assert_eq!(format_number(143.25), "143.2");
         assert_eq!(format_number(12345.0), "12345");
-        assert_eq!(format_number(123456.0), "1.235e5");
+        assert_eq!(format_number(644419.4), "644419");
+        assert_eq!(format_number(1234567890.0), "1.235e9");
         assert_eq!(format_number(0.0001234), "1.234e-4");
         assert_eq!(format_number(0.0), "0");
     }

@@ -12,8 +12,8 @@
 //! Boundary times (the segment parameter, 0 at the start, 1 at the end, at which the next
 //! boundary on an axis is crossed) are fixed-point integers in units of 1 / [`T_ONE`]: the map
 //! update's inner loop chooses the axis with integer compares and masks, whose step-to-step
-//! latency is a third of floating point's, and every traversal here uses the same numbers, so
-//! all break exact ties (rays through edges and corners) the same way.
+//! latency is shorter than floating point's, and every traversal here uses the same numbers,
+//! so all break exact ties (rays through edges and corners) the same way.
 
 use glam::{DVec3, IVec3};
 use uavex_components::map::floor_to_key;
@@ -27,7 +27,7 @@ const T_CAP: i64 = 1 << 60;
 /// Boundary time of an axis with no step left: later than any axis with steps left.
 pub const T_RETIRED: i64 = i64::MAX;
 
-/// A segment parameter in fixed point, saturating at [`T_CAP`].
+/// A segment parameter in fixed point ([`T_ONE`] per unit), saturating at 2^60 (2^16 units).
 #[inline]
 pub fn to_fixed(t: f64) -> i64 {
     if t < T_CAP as f64 / T_ONE {

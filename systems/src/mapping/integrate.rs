@@ -225,7 +225,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
     ///   as random, so it is chosen with compares and masks, not branches (mispredicted every
     ///   other step); integer compare, mask and add take a cycle each on the step-to-step
     ///   dependency, floating-point compare and add three to four (measured: the same loop on
-    ///   f64 took about 1.4x the time);
+    ///   f64 took 1.2 to 1.4 times as long);
     /// - one integer `cursor` holds both the voxel index in the chunk and the chunk-local
     ///   coordinates, biased so that leaving the chunk shows in one mask test.
     ///

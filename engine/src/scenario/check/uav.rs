@@ -99,6 +99,20 @@ fn check_behaviour(
             positive(out, path.key("yaw_rate"), *yaw_rate);
             check_waypoints(path, waypoints, context, out);
         }
+        // Files (field, energy model) and the geometry are checked where the mission is
+        // planned (`CoverageSpec::resolve`), which names the field of every problem.
+        BehaviourSpec::Coverage(coverage) => {
+            positive(
+                out,
+                path.key("resolution_px_per_m"),
+                coverage.resolution_px_per_m,
+            );
+            positive(
+                out,
+                path.key("available_energy_j"),
+                coverage.available_energy_j,
+            );
+        }
         BehaviourSpec::Waypoints { waypoints, yaw, .. } => {
             check_waypoints(path, waypoints, context, out);
             if let Some(yaw) = yaw

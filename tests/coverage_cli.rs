@@ -161,4 +161,9 @@ fn run_flies_the_coverage_scenario_as_predicted() {
         (flown_time / predicted.time_s - 1.0).abs() < 0.05,
         "{summary}"
     );
+    // The summary itself carries the prediction beside the flown figures.
+    let uav = &summary["uavs"][0];
+    assert_eq!(uav["predicted_energy_j"].as_f64(), Some(predicted.energy_j));
+    assert_eq!(uav["predicted_time_s"].as_f64(), Some(predicted.time_s));
+    assert_eq!(uav["energy_j"].as_f64(), Some(flown_energy));
 }

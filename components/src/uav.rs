@@ -52,3 +52,11 @@ pub enum UavEnded {
     /// Drew the usable energy of its battery (flight dynamics only).
     BatteryEmpty { time_s: f64, position: Vec3 },
 }
+
+/// A behaviour's own prediction of its mission, made before flying it (e.g. a coverage plan's
+/// energy from its speed-based model, coverage.md eq. 18), reported beside the flown figures.
+#[derive(Component, Debug, Clone, Copy, PartialEq)]
+pub struct PredictedMission {
+    pub energy_j: f64,
+    pub time_s: f64,
+}

@@ -8,6 +8,7 @@ use std::fmt::Write as _;
 use std::io;
 use std::path::Path;
 use uavex_components::sim::Outcome;
+use uavex_components::uav::PredictedMission;
 use uavex_systems::flight::EnergySummary;
 
 /// Per-UAV part of the summary.
@@ -34,6 +35,10 @@ pub struct UavSummary {
     pub power_std_w: Option<f64>,
     /// Fraction of the battery's full capacity left at the end.
     pub battery_soc_end: Option<f64>,
+    /// The behaviour's prediction of its mission energy (J) and time (s), made before flight;
+    /// `null` for behaviours that make none.
+    pub predicted_energy_j: Option<f64>,
+    pub predicted_time_s: Option<f64>,
 }
 
 impl UavSummary {
@@ -45,6 +50,7 @@ impl UavSummary {
         status: String,
         ended: Option<(f64, [f32; 3])>,
         energy: Option<&EnergySummary>,
+        predicted: Option<PredictedMission>,
     ) -> Self {
         Self {
             name,
@@ -57,6 +63,8 @@ impl UavSummary {
             peak_power_w: energy.map(|e| e.peak_power_w),
             power_std_w: energy.map(|e| e.power_std_w),
             battery_soc_end: energy.map(|e| e.battery_soc_end),
+            predicted_energy_j: predicted.map(|p| p.energy_j),
+            predicted_time_s: predicted.map(|p| p.time_s),
         }
     }
 }
@@ -222,7 +230,7 @@ mod tests {
 
     #[test]
     fn kinematic_uavs_have_null_energy() {
-        let summary = UavSummary::new("k".into(), 2.0, "finished".into(), None, None);
+        let summary = UavSummary::new("k".into(), 2.0, "finished".into(), None, None, None);
         let json = serde_json::to_value(&summary).unwrap();
         assert!(json["energy_j"].is_null() && json["battery_soc_end"].is_null());
         assert!(json["ended_position"].is_null());

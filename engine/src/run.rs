@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 use uavex_components::map::{MapConfig, MapTotals};
 use uavex_components::sim::{Outcome, SimClock};
-use uavex_components::uav::{Uav, UavEnded};
+use uavex_components::uav::{PredictedMission, Uav, UavEnded};
 use uavex_components::world::WorldGeometry;
 use uavex_systems::flight::{EnergySummary, FlightEnergy};
 use uavex_systems::mapping::{MapReader, OccupancyMap, map_accuracy};
@@ -69,6 +69,15 @@ pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, 
     Ok(summary)
 }
 
+/// What the summary needs of one UAV: index, name, ending, energy account, prediction.
+type UavEnding = (
+    usize,
+    String,
+    Option<UavEnded>,
+    Option<EnergySummary>,
+    Option<PredictedMission>,
+);
+
 /// The summary of a finished (or failed) run, from what the world holds.
 fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: String) -> RunSummary {
     let world = &mut sim.world;
@@ -83,12 +92,23 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
         map_accuracy(reader, |key| geometry.voxel_key_occupied(key, resolution))
     })
     .flatten();
-    let mut uavs: Vec<(usize, String, Option<UavEnded>, Option<EnergySummary>)> = world
-        .query::<(&Uav, Option<&UavEnded>, Option<&FlightEnergy>)>()
+    let mut uavs: Vec<UavEnding> = world
+        .query::<(
+            &Uav,
+            Option<&UavEnded>,
+            Option<&FlightEnergy>,
+            Option<&PredictedMission>,
+        )>()
         .iter(world)
-        .map(|(uav, ended, energy)| {
+        .map(|(uav, ended, energy, predicted)| {
             let energy = energy.map(FlightEnergy::summary);
-            (uav.index, uav.name.clone(), ended.cloned(), energy)
+            (
+                uav.index,
+                uav.name.clone(),
+                ended.cloned(),
+                energy,
+                predicted.copied(),
+            )
         })
         .collect();
     uavs.sort_by_key(|(index, ..)| *index);
@@ -130,7 +150,7 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
         battery_soc_end,
         uavs: uavs
             .into_iter()
-            .map(|(index, name, ended, energy)| {
+            .map(|(index, name, ended, energy, predicted)| {
                 let (status, at) = match ended {
                     None => ("flying", None),
                     Some(UavEnded::Finished) => ("finished", None),
@@ -147,6 +167,7 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
                     status.to_owned(),
                     at,
                     energy.as_ref(),
+                    predicted,
                 )
             })
             .collect(),

@@ -13,6 +13,7 @@ use glam::DVec3;
 use std::path::Path;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
+use uavex_components::uav::PredictedMission;
 use uavex_components::uav::QuadState;
 use uavex_systems::behaviour::waypoints::WaypointTour;
 use uavex_systems::flight::{
@@ -78,6 +79,10 @@ pub fn coverage_flight(
         FlightEnergy::new(&airframe.battery),
         WaypointTour {
             completion: Completion::default(),
+        },
+        PredictedMission {
+            energy_j: outcome.plan.energy_j,
+            time_s: outcome.plan.time_s,
         },
     ))
 }

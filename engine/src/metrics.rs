@@ -51,6 +51,9 @@ pub struct RunRecord {
     /// Distance flown by each UAV (index = `Uav::index`).
     pub path_length_m: Vec<f64>,
     last_position: Vec<Option<Vec3>>,
+    /// This tick's power of each UAV (index = `Uav::index`), `None` for kinematic ones: summed
+    /// in index order, so the fleet total does not depend on ECS iteration order.
+    power_w: Vec<Option<f64>>,
     /// The fleet's total rotor power over time (the sum over dynamic UAVs, every tick), for
     /// the run's average, peak and spread of power; `None` while no UAV flies dynamically.
     /// (Its path length is not used.)
@@ -68,6 +71,7 @@ impl RunRecord {
             path_length_m: vec![0.0; uav_count],
             last_position: vec![None; uav_count],
             fleet_power: None,
+            power_w: vec![None; uav_count],
         }
     }
 
@@ -123,15 +127,17 @@ pub fn record_metrics(
     uavs: Query<(&Uav, &QuadState, Option<&FlightEnergy>)>,
 ) {
     let time_s = clock.time_s();
-    let mut uavs: Vec<_> = uavs.iter().collect();
-    uavs.sort_by_key(|(uav, ..)| uav.index);
-    let mut fleet_power: Option<f64> = None;
+    // Every tick: no allocation, fixed order through the UAV index.
     for (uav, state, energy) in &uavs {
         record.note_position(uav.index, state.position);
-        if let Some(energy) = energy {
-            *fleet_power.get_or_insert(0.0) += energy.power_w;
-        }
+        record.power_w[uav.index] = energy.map(|e| e.power_w);
     }
+    let fleet_power = record
+        .power_w
+        .iter()
+        .flatten()
+        .copied()
+        .reduce(|a, b| a + b);
     if let Some(power_w) = fleet_power {
         record.note_fleet_power(clock.dt, power_w);
     }
@@ -141,6 +147,8 @@ pub fn record_metrics(
         return;
     }
     record.map_rows.push(MapRow { time_s, metrics });
+    let mut uavs: Vec<_> = uavs.iter().collect();
+    uavs.sort_by_key(|(uav, ..)| uav.index);
     for (uav, state, energy) in uavs {
         let forward = state.attitude * Vec3::X;
         let row = UavRow {

@@ -6,14 +6,15 @@
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
-use rapier3d::prelude::{Pose, Rotation, SharedShape, Vector};
-use std::f32::consts::{FRAC_PI_2, PI};
+use rapier3d::prelude::{Pose, SharedShape};
 use std::hint::black_box;
 use uavex_components::airframe::Airframe;
-use uavex_components::sim::{Outcome, SimClock};
+use uavex_components::sim::{Outcome, RunSeed, SimClock};
 use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
 use uavex_engine::physics::{FlightWorld, FlightWorldConfig, UavHandle, UavStatus};
+use uavex_engine::scenario;
 use uavex_engine::sim::Sim;
+use uavex_engine::world::build_world;
 use uavex_systems::flight::{
     ControllerGains, FlightState, GeometricController, RolloutConfig, rollout, rollout_batch,
 };
@@ -21,31 +22,18 @@ use uavex_systems::trajectory::{
     CurveReference, DynamicLimits, Waypoint, min_snap_with_durations, plan_collision_free,
 };
 
-/// The EAAE "Pillars" scene (worlds/eaae.md) and the ground.
+/// The EAAE "Pillars" scene as shipped (`scenarios/eaae_pillars.toml`), ground included: the
+/// same geometry the runs use, built by the same world builder.
 fn pillars() -> Vec<(Pose, SharedShape)> {
-    let boxes: [([f32; 3], [f32; 3], f32); 7] = [
-        ([10.6641, 0.1746, 1.25], [22.5, 0.15, 2.5], -FRAC_PI_2),
-        ([-0.1359, -11.0004, 1.25], [21.75, 0.15, 2.5], PI),
-        ([-10.9359, 0.1746, 1.25], [22.5, 0.15, 2.5], FRAC_PI_2),
-        ([-0.1359, 11.3497, 1.25], [21.75, 0.15, 2.5], 0.0),
-        ([-0.3643, -6.3997, 1.25], [2.0, 2.0, 2.5], 0.0),
-        ([5.2752, 4.8380, 1.25], [2.0, 2.0, 2.5], -FRAC_PI_2),
-        ([-5.1558, 4.5622, 1.25], [2.0, 2.0, 2.5], -FRAC_PI_2),
-    ];
-    let mut shapes: Vec<_> = boxes
+    let loaded = scenario::load("scenarios/eaae_pillars.toml").expect("the shipped scene loads");
+    let spec = &loaded.scenario;
+    let world = build_world(&spec.world, RunSeed(spec.seed), &[], &loaded.base_dir)
+        .expect("the shipped scene builds");
+    world
+        .obstacles()
         .iter()
-        .map(|(c, s, yaw)| {
-            (
-                Pose::from_parts(Vector::from_array(*c), Rotation::from_rotation_z(*yaw)),
-                SharedShape::cuboid(s[0] / 2.0, s[1] / 2.0, s[2] / 2.0),
-            )
-        })
-        .collect();
-    shapes.push((
-        Pose::from_translation(Vector::new(0.0, 0.0, -0.5)),
-        SharedShape::cuboid(100.0, 100.0, 0.5),
-    ));
-    shapes
+        .map(|o| (o.pose, o.shape.clone()))
+        .collect()
 }
 
 /// One UAV in the Pillars scene, flying `reference` with the controller, one step per call.

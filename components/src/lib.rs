@@ -3,6 +3,8 @@
 //! Nothing here has behaviour beyond small accessors; algorithms live in `uavex-systems`.
 
 pub mod airframe;
+pub mod exploration;
+pub mod frontier;
 pub mod map;
 pub mod sensor;
 pub mod sim;

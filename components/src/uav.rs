@@ -49,6 +49,9 @@ pub enum UavEnded {
     Finished,
     /// Touched world geometry.
     Crashed { time_s: f64, position: Vec3 },
+    /// Flew home because no further goal was affordable within its energy budget, and
+    /// arrived (exploration with a budget).
+    ReturnedHome { time_s: f64 },
     /// Drew the usable energy of its battery (flight dynamics only).
     BatteryEmpty { time_s: f64, position: Vec3 },
 }

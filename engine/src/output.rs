@@ -112,9 +112,28 @@ pub struct RunSummary {
     pub power_std_w: Option<f64>,
     /// The lowest state of charge among the UAVs' batteries at the end.
     pub battery_soc_end: Option<f64>,
+    /// The exploration keys, for runs in which some UAV explores (flattened into the record).
+    #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
+    pub exploration: Option<ExplorationKeys>,
     pub uavs: Vec<UavSummary>,
     /// Host time the run took (s); the one field that is not deterministic.
     pub wall_time_s: f64,
+}
+
+/// The summary keys of an exploration run (eaae.md; the list).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct ExplorationKeys {
+    /// Decisions that chose a goal.
+    pub decisions: u64,
+    /// Mission time when the run ended `complete` (no reachable frontier left), else `null`.
+    pub completion_time_s: Option<f64>,
+    /// Mean |flown - predicted| / predicted energy over the goals reached.
+    pub mean_prediction_error: Option<f64>,
+    /// Median and 95th percentile of the wall-clock time of a decision (ms).
+    pub decision_ms_p50: Option<f64>,
+    pub decision_ms_p95: Option<f64>,
+    /// Known share of the free space connected to the start (%), from the ground truth.
+    pub explored_reachable_pct: Option<f64>,
 }
 
 /// Writes `contents` to `path` through a temporary file and a rename.

@@ -2,9 +2,13 @@
 //! fails (a panic anywhere in a system) is recorded as `failed` with its reason, and whatever
 //! was computed until then is still written.
 
+use crate::exploration::{ExplorationSummary, decision_timings_csv, decisions_csv};
 use crate::formats::{octomap, ply};
 use crate::metrics::{EXPLORED_THRESHOLDS, RunRecord};
-use crate::output::{RunSummary, UavSummary, map_series_csv, uav_series_csv, write_atomically};
+use crate::output::{
+    ExplorationKeys, RunSummary, UavSummary, map_series_csv, uav_series_csv, write_atomically,
+};
+use crate::reachable::ReachableVolume;
 use crate::scenario::{self, LoadedScenario, ScenarioErrors};
 use crate::sim::Sim;
 use bevy_ecs::prelude::World;
@@ -12,6 +16,7 @@ use bevy_ecs::system::SystemState;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
+use uavex_components::exploration::{DecisionLog, DecisionTimings, Explorer};
 use uavex_components::map::{MapConfig, MapTotals};
 use uavex_components::sim::{Outcome, SimClock};
 use uavex_components::uav::{PredictedMission, Uav, UavEnded};
@@ -115,6 +120,7 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
     let energies: Vec<&EnergySummary> = uavs.iter().filter_map(|u| u.3.as_ref()).collect();
     let energy_j = (!energies.is_empty()).then(|| energies.iter().map(|e| e.energy_j).sum());
     let battery_soc_end = energies.iter().map(|e| e.battery_soc_end).reduce(f64::min);
+    let exploration = exploration_summary(world, outcome, time_s);
     let mut record = world.resource_mut::<RunRecord>();
     record.close(time_s, metrics);
     let record = world.resource::<RunRecord>();
@@ -148,12 +154,14 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
         peak_power_w: record.fleet_power.as_ref().map(|f| f.peak_power_w),
         power_std_w: record.fleet_power.as_ref().map(|f| f.power_std_w()),
         battery_soc_end,
+        exploration,
         uavs: uavs
             .into_iter()
             .map(|(index, name, ended, energy, predicted)| {
                 let (status, at) = match ended {
                     None => ("flying", None),
                     Some(UavEnded::Finished) => ("finished", None),
+                    Some(UavEnded::ReturnedHome { .. }) => ("returned_home", None),
                     Some(UavEnded::Crashed { time_s, position }) => {
                         ("crashed", Some((time_s, position.to_array())))
                     }
@@ -173,6 +181,40 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
             .collect(),
         wall_time_s: 0.0,
     }
+}
+
+/// The exploration keys of the summary, when some UAV explores: decisions, completion time,
+/// prediction error, decision times, and the share of the reachable volume explored (the
+/// free space connected to the first explorer's start, `crate::reachable`).
+fn exploration_summary(
+    world: &mut World,
+    outcome: Outcome,
+    time_s: f64,
+) -> Option<ExplorationKeys> {
+    let log = world.get_resource::<DecisionLog>()?;
+    let timings = world.get_resource::<DecisionTimings>()?;
+    let summary = ExplorationSummary::of(log, timings);
+    let home = world
+        .query::<(&Uav, &Explorer)>()
+        .iter(world)
+        .min_by_key(|(uav, _)| uav.index)
+        .map(|(_, explorer)| explorer.home)?;
+    let reachable = ReachableVolume::flood(
+        world.resource::<MapConfig>(),
+        world.resource::<WorldGeometry>(),
+        home,
+    )
+    .ok();
+    let explored_reachable_pct =
+        reachable.and_then(|r| with_map(world, |reader, _| r.explored_pct(reader)));
+    Some(ExplorationKeys {
+        decisions: summary.decisions,
+        completion_time_s: (outcome == Outcome::Complete).then_some(time_s),
+        mean_prediction_error: summary.mean_prediction_error,
+        decision_ms_p50: summary.decision_ms_p50,
+        decision_ms_p95: summary.decision_ms_p95,
+        explored_reachable_pct,
+    })
 }
 
 /// Writes summary, series and (optionally) the map exports into `dir`.
@@ -211,6 +253,15 @@ fn write_outputs(
         .ok_or_else(|| std::io::Error::other("the map is not readable"))??;
         write_atomically(&dir.join("map.bt"), &bt)?;
         write_atomically(&dir.join("map_occupied.ply"), &cloud)?;
+    }
+    if let Some(log) = world.get_resource::<DecisionLog>() {
+        write_atomically(&dir.join("decisions.csv"), decisions_csv(log).as_bytes())?;
+    }
+    if let Some(timings) = world.get_resource::<DecisionTimings>() {
+        write_atomically(
+            &dir.join("decision_timings.csv"),
+            decision_timings_csv(timings).as_bytes(),
+        )?;
     }
     // The summary goes last: its presence marks a run whose files are all written.
     let json = serde_json::to_vec_pretty(summary).map_err(std::io::Error::other)?;

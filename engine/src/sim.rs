@@ -1,6 +1,8 @@
 //! The simulation of one run: a bevy `World` built from one scenario and one seed, and the
 //! `Tick` schedule with the pipeline stages (DESIGN.md "One tick").
 
+use crate::exploration::setup::camera_of;
+use crate::exploration::{add_exploration, explorer_components};
 use crate::flight::{Physics, airframe_of, end_on_empty_battery, step_physics, waypoint_flight};
 use crate::metrics::{RunRecord, record_metrics};
 use crate::scenario::{BehaviourSpec, LoadedScenario, ScenarioErrors};
@@ -8,6 +10,7 @@ use crate::world::{build_world, check_starts_with_radii, sensor_bundle};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::ScheduleSystem;
 use glam::{DVec3, Vec3};
+use uavex_components::airframe::Airframe;
 use uavex_components::map::{MapConfig, MapSettings};
 use uavex_components::sensor::SensorId;
 use uavex_components::sim::{Outcome, RunEnd, RunSeed, SimClock};
@@ -73,7 +76,9 @@ impl Sim {
         let dynamic = scenario.uavs.iter().any(|u| {
             matches!(
                 u.behaviour,
-                BehaviourSpec::Waypoints { .. } | BehaviourSpec::Coverage(_)
+                BehaviourSpec::Waypoints { .. }
+                    | BehaviourSpec::Coverage(_)
+                    | BehaviourSpec::Explore(_)
             )
         });
         let mut physics = if dynamic {
@@ -105,6 +110,8 @@ impl Sim {
 
         let mut problems = Vec::new();
         let mut next_sensor_id = 0;
+        // The first explorer's camera, and every explorer's airframe.
+        let mut exploration: Option<((f64, f64), Vec<&Airframe>)> = None;
         for (index, (spec, airframe)) in scenario.uavs.iter().zip(&airframes).enumerate() {
             let state = QuadState::at_rest(starts[index], spec.start.yaw as f32);
             let uav = world
@@ -145,6 +152,25 @@ impl Sim {
                     ) {
                         Ok(flight) => {
                             world.entity_mut(uav).insert(flight);
+                        }
+                        Err(e) => problems.push(e),
+                    }
+                }
+                BehaviourSpec::Explore(explore) => {
+                    let Some(physics) = physics.as_mut() else {
+                        continue;
+                    };
+                    match explorer_components(spec, index, airframe, physics, explore) {
+                        Ok((bundle, strategy)) => {
+                            let mut entity = world.entity_mut(uav);
+                            entity.insert(bundle);
+                            strategy.insert(&mut entity);
+                            if let Some(camera) = camera_of(spec) {
+                                exploration
+                                    .get_or_insert_with(|| (camera, Vec::new()))
+                                    .1
+                                    .push(airframe);
+                            }
                         }
                         Err(e) => problems.push(e),
                     }
@@ -201,6 +227,9 @@ impl Sim {
                 .chain()
                 .in_set(Stage::Account),
         ));
+        if let Some((camera, airframes)) = exploration {
+            add_exploration(&mut world, &mut schedule, camera, &airframes);
+        }
         if let Some(physics) = physics {
             world.insert_resource(physics);
             schedule.add_systems((
@@ -254,15 +283,29 @@ impl Sim {
     }
 }
 
-/// Account stage: the run is complete once every UAV has ended its behaviour.
+/// Account stage: the run is complete once every UAV has ended its behaviour; `returned_home`
+/// when some UAV ended by flying home on its energy budget.
 pub fn end_when_every_uav_is_done(
     mut run_end: ResMut<RunEnd>,
-    uavs: Query<Has<UavEnded>, With<Uav>>,
+    uavs: Query<Option<&UavEnded>, With<Uav>>,
 ) {
-    if run_end.0.is_none() && !uavs.is_empty() && uavs.iter().all(|ended| ended) {
-        run_end.0 = Some((
+    if run_end.0.is_some() || uavs.is_empty() || uavs.iter().any(|ended| ended.is_none()) {
+        return;
+    }
+    let home = uavs.iter().flatten().find_map(|ended| match ended {
+        UavEnded::ReturnedHome { time_s } => Some(*time_s),
+        _ => None,
+    });
+    run_end.0 = Some(match home {
+        Some(time_s) => (
+            Outcome::ReturnedHome,
+            format!(
+                "no further goal was affordable within the energy budget; home at {time_s:.1} s"
+            ),
+        ),
+        None => (
             Outcome::Complete,
             "every UAV completed its behaviour".to_owned(),
-        ));
-    }
+        ),
+    });
 }

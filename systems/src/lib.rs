@@ -3,8 +3,11 @@
 //! them.
 pub mod behaviour;
 pub mod coverage;
+pub mod exploration;
 pub mod flight;
+pub mod frontier;
 pub mod mapping;
+pub mod planning;
 pub mod sensing;
 pub mod stages;
 pub mod trajectory;

@@ -5,7 +5,7 @@
 
 use super::flight::plan_profile;
 use super::spec::CoverageSpec;
-use crate::flight::{Physics, PhysicsBody};
+use crate::flight::{Physics, dynamic_flight};
 use crate::scenario::UavSpec;
 use crate::world::BuildError;
 use bevy_ecs::bundle::Bundle;
@@ -14,12 +14,8 @@ use std::path::Path;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
 use uavex_components::uav::PredictedMission;
-use uavex_components::uav::QuadState;
 use uavex_systems::behaviour::waypoints::WaypointTour;
-use uavex_systems::flight::{
-    Completion, ControllerGains, FlightController, FlightEnergy, FlightState, GeometricController,
-    ReferenceTrajectory, RotorCommands,
-};
+use uavex_systems::flight::Completion;
 
 /// Farthest the UAV may start from the field's start vertex (m): it takes off there.
 const START_TOLERANCE_M: f64 = 1.0;
@@ -55,28 +51,8 @@ pub fn coverage_flight(
         ));
     }
     let profile = plan_profile(&outcome.plan, &setup.model, start.z);
-    let controller =
-        GeometricController::new(airframe, ControllerGains::default()).ok_or_else(|| {
-            BuildError::new(
-                format!("uav[{index}].airframe_overrides"),
-                "the rotor layout cannot be mixed into thrust and torques",
-            )
-        })?;
-    let first = uavex_components::trajectory::Trajectory::sample(&profile, 0.0);
-    let hovering = FlightState::hovering(airframe, first.position, first.yaw);
-    let body = physics
-        .add(&spec.name, airframe, &hovering)
-        .map_err(|e| BuildError::new(format!("uav[{index}].start.position"), e.to_string()))?;
     Ok((
-        QuadState::from(&hovering),
-        PhysicsBody(body),
-        FlightController(controller),
-        ReferenceTrajectory {
-            trajectory: Arc::new(profile),
-            start_s: 0.0,
-        },
-        RotorCommands(hovering.rotor_speeds),
-        FlightEnergy::new(&airframe.battery),
+        dynamic_flight(&spec.name, index, airframe, physics, Arc::new(profile))?,
         WaypointTour {
             completion: Completion::default(),
         },

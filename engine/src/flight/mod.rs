@@ -8,5 +8,5 @@
 mod setup;
 mod systems;
 
-pub use setup::{airframe_of, plan_waypoints, waypoint_flight};
+pub use setup::{airframe_of, dynamic_flight, plan_waypoints, waypoint_flight};
 pub use systems::{Physics, PhysicsBody, end_on_empty_battery, step_physics};

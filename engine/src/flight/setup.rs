@@ -9,7 +9,7 @@ use bevy_ecs::bundle::Bundle;
 use glam::DVec3;
 use std::sync::Arc;
 use uavex_components::airframe::{Airframe, OVERRIDE_NAMES};
-use uavex_components::trajectory::PiecewisePolynomial;
+use uavex_components::trajectory::{PiecewisePolynomial, Trajectory};
 use uavex_components::uav::QuadState;
 use uavex_components::world::WorldGeometry;
 use uavex_systems::behaviour::waypoints::{CLEARANCE_MARGIN_M, WaypointTour, plan_tour};
@@ -105,6 +105,24 @@ pub fn waypoint_flight(
         yaw,
         collision_check,
     )?;
+    Ok((
+        dynamic_flight(&spec.name, index, airframe, physics, Arc::new(tour))?,
+        WaypointTour {
+            completion: Completion::default(),
+        },
+    ))
+}
+
+/// The components that fly `uav[index]` on the true quadrotor: its body in `physics`, hovering
+/// where `reference` starts, the geometric controller tracking `reference` from time 0, its
+/// rotor commands and its energy account. Every dynamic behaviour starts from these.
+pub fn dynamic_flight(
+    name: &str,
+    index: usize,
+    airframe: &Airframe,
+    physics: &mut Physics,
+    reference: Arc<dyn Trajectory>,
+) -> Result<impl Bundle + use<>, BuildError> {
     let controller =
         GeometricController::new(airframe, ControllerGains::default()).ok_or_else(|| {
             BuildError::new(
@@ -112,27 +130,21 @@ pub fn waypoint_flight(
                 "the rotor layout cannot be mixed into thrust and torques",
             )
         })?;
-    let start = FlightState::hovering(
-        airframe,
-        DVec3::from_array(spec.start.position),
-        spec.start.yaw,
-    );
+    let first = reference.sample(0.0);
+    let start = FlightState::hovering(airframe, first.position, first.yaw);
     let body = physics
-        .add(&spec.name, airframe, &start)
+        .add(name, airframe, &start)
         .map_err(|e| BuildError::new(format!("uav[{index}].start.position"), e.to_string()))?;
     Ok((
         QuadState::from(&start),
         PhysicsBody(body),
         FlightController(controller),
         ReferenceTrajectory {
-            trajectory: Arc::new(tour),
+            trajectory: reference,
             start_s: 0.0,
         },
         RotorCommands(start.rotor_speeds),
         FlightEnergy::new(&airframe.battery),
-        WaypointTour {
-            completion: Completion::default(),
-        },
     ))
 }
 

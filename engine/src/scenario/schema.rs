@@ -272,7 +272,7 @@ pub struct QualitySpec {
     pub range_noise_std: f64,
 }
 
-/// What a UAV does. Later kinds (exploration, coverage) are added here.
+/// What a UAV does.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BehaviourSpec {
@@ -308,6 +308,10 @@ pub enum BehaviourSpec {
     /// Energy-aware coverage of a polygon with a nadir camera (coverage.md): planned by
     /// `uavex cover`, which also flies the plan on the true quadrotor with `--fly`.
     Coverage(crate::coverage::CoverageSpec),
+    /// Frontier exploration (eaae.md): every next frontier cluster chosen by the `strategy`
+    /// (`eaae`: least predicted energy; `classic`, `nearest`: the baselines), flown on the true
+    /// quadrotor with a local reactive planner until no reachable frontier is left.
+    Explore(crate::exploration::ExploreSpec),
 }
 
 /// What a run writes besides `summary.json`.

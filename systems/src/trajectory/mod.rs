@@ -42,6 +42,8 @@ pub enum PlanError {
     LimitsUnreachable,
     #[error("the minimum-snap system is singular")]
     Singular,
+    #[error("no path through known free space leads to {goal}")]
+    NoPath { goal: DVec3 },
     #[error("internal error: {0}")]
     Internal(String),
 }

@@ -7,6 +7,7 @@ use super::{
     KNOWN_AIRFRAMES, MAX_RAYS_PER_SCAN, UavPart, angle, at_least_one, inside, non_negative,
     positive, triple,
 };
+use crate::exploration::CandidateCount;
 use crate::scenario::diagnostic::{Finding, number};
 use crate::scenario::path::FieldPath;
 use crate::scenario::schema::{
@@ -112,6 +113,19 @@ fn check_behaviour(
                 path.key("available_energy_j"),
                 coverage.available_energy_j,
             );
+        }
+        BehaviourSpec::Explore(explore) => {
+            positive(out, path.key("replan_hz"), explore.replan_hz);
+            if let CandidateCount::Count(n) = explore.candidates {
+                at_least_one(out, path.key("candidates"), n);
+            }
+            if let Some(budget) = explore.energy_budget {
+                non_negative(
+                    out,
+                    path.key("energy_budget").key("reserve_j"),
+                    budget.reserve_j,
+                );
+            }
         }
         BehaviourSpec::Waypoints { waypoints, yaw, .. } => {
             check_waypoints(path, waypoints, context, out);

@@ -1,0 +1,79 @@
+//! Exploration cost (issue 4 benchmarks), on ONE core (a one-thread rayon pool, so candidate
+//! planning and rollouts get no second core):
+//!
+//! 1. decision time in the EAAE Pillars scene with every cluster evaluated (`candidates =
+//!    "all"`): p50 / p95 / max over every decision of a whole mission, split as EAAE Table 6.2
+//!    (clustering, trajectory generation, energy estimation). Goal: p95 <= 20 ms.
+//! 2. whole-mission real-time factor of the shipped `eaae` Pillars run (simulated time / wall
+//!    time, everything included: sensing, mapping, frontiers, decisions, planning, physics).
+//!    Goal: >= 100x.
+//!
+//! Whole missions take tens of seconds, so this is a plain timed program (`harness = false`),
+//! not a criterion loop: `cargo bench --bench exploration`. Each mission is run once per seed;
+//! the figures printed are what the README quotes.
+
+use std::time::Instant;
+use uavex_components::exploration::{DecisionLog, DecisionTiming, DecisionTimings};
+use uavex_engine::exploration::{AllCandidates, CandidateCount};
+use uavex_engine::scenario::{BehaviourSpec, load};
+use uavex_engine::sim::Sim;
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    let rank = (q * sorted.len() as f64).ceil().max(1.0) as usize;
+    sorted[rank.min(sorted.len()) - 1]
+}
+
+fn main() {
+    // `cargo bench` passes `--bench`; a filter argument, if any, is ignored.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/eaae_pillars.toml");
+    let shipped = load(path).unwrap_or_else(|e| panic!("{e}"));
+
+    println!("exploration bench, one core (EAAE Pillars)");
+    for seed in [1u64, 2] {
+        // 1. Every cluster evaluated.
+        let mut all = shipped.clone();
+        if let BehaviourSpec::Explore(explore) = &mut all.scenario.uavs[0].behaviour {
+            explore.candidates = CandidateCount::Named(AllCandidates::All);
+        }
+        let mut sim = Sim::build(&all, seed).unwrap_or_else(|e| panic!("{e}"));
+        let (outcome, _) = pool.install(|| sim.run_to_end());
+        let timings: Vec<DecisionTiming> =
+            sim.world.resource::<DecisionTimings>().decisions.clone();
+        let log = sim.world.resource::<DecisionLog>();
+        let candidates: usize = log.decisions.iter().map(|d| d.candidates.len()).sum();
+        let mut totals: Vec<f64> = timings.iter().map(|t| t.total_ms).collect();
+        totals.sort_by(f64::total_cmp);
+        let mean = |f: fn(&DecisionTiming) -> f64| {
+            timings.iter().map(f).sum::<f64>() / timings.len().max(1) as f64
+        };
+        println!(
+            "seed {seed}, candidates = all: {} decisions ({:.1} candidates each), {outcome:?}; \
+             decision ms p50 {:.2}, p95 {:.2}, max {:.2}; mean ms clustering {:.2}, \
+             trajectories {:.2}, energy {:.2}",
+            timings.len(),
+            candidates as f64 / log.decisions.len().max(1) as f64,
+            quantile(&totals, 0.5),
+            quantile(&totals, 0.95),
+            totals.last().copied().unwrap_or(0.0),
+            mean(|t| t.clustering_ms),
+            mean(|t| t.trajectory_ms),
+            mean(|t| t.energy_ms),
+        );
+
+        // 2. The shipped run, timed whole.
+        let mut sim = Sim::build(&shipped, seed).unwrap_or_else(|e| panic!("{e}"));
+        let started = Instant::now();
+        let (outcome, _) = pool.install(|| sim.run_to_end());
+        let wall = started.elapsed().as_secs_f64();
+        let simulated = sim.time_s();
+        println!(
+            "seed {seed}, shipped eaae run: {simulated:.1} s simulated in {wall:.2} s wall, \
+             real-time factor {:.1}x, {outcome:?}",
+            simulated / wall
+        );
+    }
+}

@@ -1,0 +1,82 @@
+//! The exploration behaviour's settings as they appear in a scenario file (eaae.md), under
+//! `[uav.behaviour] kind = "explore"`:
+//!
+//! ```toml
+//! [uav.behaviour]
+//! kind = "explore"
+//! strategy = "eaae"          # or "classic" (largest frontier), "nearest" (nearest frontier)
+//! candidates = 3             # EAAE: clusters of largest IG weighed by energy; or "all"
+//! unified = false            # fly the evaluated candidate itself while it stays free
+//! replan_hz = 2.0            # local planner's regular replanning rate
+//! energy_budget = { reserve_j = 5000.0 }   # optional: return home before the battery runs low
+//! ```
+//! Everything but `strategy` has the default shown.
+
+use serde::{Deserialize, Serialize};
+
+/// The strategies a scenario can name.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum StrategyName {
+    /// Least predicted energy among the `candidates` clusters of largest IG (eaae.md step 8).
+    Eaae,
+    /// Largest information gain (eaae.md "Baselines").
+    Classic,
+    /// Nearest centroid (eaae.md "Baselines").
+    Nearest,
+}
+
+/// How many clusters EAAE weighs by energy: a number, or `"all"`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum CandidateCount {
+    Count(u32),
+    Named(AllCandidates),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum AllCandidates {
+    All,
+}
+
+impl CandidateCount {
+    /// `None` for all.
+    pub fn limit(self) -> Option<usize> {
+        match self {
+            CandidateCount::Count(n) => Some(n as usize),
+            CandidateCount::Named(AllCandidates::All) => None,
+        }
+    }
+}
+
+/// The energy budget: keep this much in reserve beyond the predicted flight home.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BudgetSpec {
+    pub reserve_j: f64,
+}
+
+/// `kind = "explore"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExploreSpec {
+    pub strategy: StrategyName,
+    /// EAAE's N (the thesis: 3); ignored by the baselines, which choose among all.
+    #[serde(default = "default_candidates")]
+    pub candidates: CandidateCount,
+    #[serde(default)]
+    pub unified: bool,
+    #[serde(default = "default_replan_hz")]
+    pub replan_hz: f64,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub energy_budget: Option<BudgetSpec>,
+}
+
+fn default_candidates() -> CandidateCount {
+    CandidateCount::Count(3)
+}
+
+fn default_replan_hz() -> f64 {
+    2.0
+}

@@ -1,0 +1,28 @@
+//! Classic frontier baseline (eaae.md "Baselines"): `c* = argmax IG(c)` over all feasible
+//! clusters.
+
+use super::{CandidateQuery, CandidateView, Deciding, choosable, first_min_by};
+use bevy_ecs::prelude::*;
+use uavex_components::exploration::Chosen;
+
+/// Marker of a UAV that goes to the largest frontier cluster.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct ClassicStrategy;
+
+/// The largest information gain (plain function).
+pub fn largest_gain(candidates: &[CandidateView]) -> Option<Entity> {
+    first_min_by(candidates, |c| -f64::from(c.information_gain)).map(|c| c.entity)
+}
+
+/// Choose step of the Classic baseline.
+pub fn choose_largest_gain(
+    mut commands: Commands,
+    uavs: Deciding<ClassicStrategy>,
+    candidates: CandidateQuery,
+) {
+    for (uav, list) in &uavs {
+        if let Some(pick) = largest_gain(&choosable(list, &candidates)) {
+            commands.entity(uav).insert(Chosen(pick));
+        }
+    }
+}

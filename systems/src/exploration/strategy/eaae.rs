@@ -1,0 +1,40 @@
+//! EAAE (eaae.md steps 5 and 8): among the N clusters of largest information gain, the one
+//! whose candidate trajectory the rollout predicts to need the least energy,
+//! `pi* = argmin E(pi_i)`. The thesis used N = 3; `None` weighs every candidate.
+
+use super::{CandidateQuery, CandidateView, choosable, first_min_by};
+use bevy_ecs::prelude::*;
+use uavex_components::exploration::{Candidates, Chosen, NeedsDecision};
+
+/// Marker of a UAV that explores with EAAE's choice.
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
+pub struct EaaeStrategy {
+    /// How many candidates of largest IG are weighed by energy (`None`: all).
+    pub shortlist: Option<usize>,
+}
+
+/// The EAAE choice among `candidates` (plain function).
+pub fn least_energy_among_largest_gain(
+    candidates: &[CandidateView],
+    shortlist: Option<usize>,
+) -> Option<Entity> {
+    let mut by_gain = candidates.to_vec();
+    // Stable: equal gains keep their order.
+    by_gain.sort_by_key(|c| std::cmp::Reverse(c.information_gain));
+    by_gain.truncate(shortlist.unwrap_or(usize::MAX));
+    first_min_by(&by_gain, |c| c.energy_j).map(|c| c.entity)
+}
+
+/// Choose step of EAAE.
+pub fn choose_least_energy(
+    mut commands: Commands,
+    uavs: Query<(Entity, &EaaeStrategy, &Candidates), With<NeedsDecision>>,
+    candidates: CandidateQuery,
+) {
+    for (uav, strategy, list) in &uavs {
+        let views = choosable(list, &candidates);
+        if let Some(pick) = least_energy_among_largest_gain(&views, strategy.shortlist) {
+            commands.entity(uav).insert(Chosen(pick));
+        }
+    }
+}

@@ -1,0 +1,62 @@
+//! Whether a trajectory stays in traversable space: the acceptance test of every plan, and the
+//! replanning trigger of the local planner (EAAE step 9: replan "whenever the map makes the
+//! current trajectory collide").
+//!
+//! Samples are taken every `spacing / max_speed` seconds (`crate::trajectory::collision`): a
+//! reference moving at most `max_speed` moves at most `spacing` between two samples, and with
+//! [`COLLISION_SAMPLE_SPACING_M`] = half a 0.1 m voxel no voxel the path crosses goes unseen.
+//!
+//! Escape rule: a trajectory whose first sample is not traversable (the reference starts next
+//! to a wall, or the map changed around it) may leave that place, as long as it stays within
+//! [`SNAP_RADIUS_M`] of its first sample until it reaches traversable space; from there on,
+//! every sample must be traversable. Without it, a UAV pushed 5 cm too close to a wall could
+//! never plan again.
+
+use super::search::SNAP_RADIUS_M;
+use super::traversable::TraversableGrid;
+use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
+use glam::DVec3;
+use uavex_components::trajectory::Trajectory;
+
+/// The first sample from `t0` on that breaks the traversability (with the escape rule of the
+/// module doc), as (time, position); `None` when there is none. Non-positive or non-finite
+/// `max_speed` or times count as a failure at `t0`.
+pub fn first_untraversable(
+    grid: &TraversableGrid,
+    trajectory: &dyn Trajectory,
+    t0: f64,
+    max_speed: f64,
+) -> Option<(f64, DVec3)> {
+    let end = trajectory.duration();
+    let valid = max_speed.is_finite() && max_speed > 0.0 && t0.is_finite() && end.is_finite();
+    if !valid {
+        return Some((t0, trajectory.sample(0.0).position));
+    }
+    let step = COLLISION_SAMPLE_SPACING_M / max_speed;
+    let t0 = t0.clamp(0.0, end);
+    let samples = ((end - t0) / step).ceil() as u64;
+    let origin = trajectory.sample(t0).position;
+    let mut escaping = !grid.is_traversable_point(origin);
+    for i in 0..=samples {
+        let t = (t0 + i as f64 * step).min(end);
+        let p = trajectory.sample(t).position;
+        if grid.is_traversable_point(p) {
+            escaping = false;
+        } else if !escaping || p.distance(origin) > SNAP_RADIUS_M {
+            return Some((t, p));
+        }
+    }
+    None
+}
+
+/// Whether the rest of `trajectory` from `t0` is still traversable on the latest grid (the
+/// local planner's replanning trigger). `max_speed` bounds the trajectory's speed (the
+/// airframe's vmax for planned trajectories).
+pub fn remains_traversable(
+    grid: &TraversableGrid,
+    trajectory: &dyn Trajectory,
+    t0: f64,
+    max_speed: f64,
+) -> bool {
+    first_untraversable(grid, trajectory, t0, max_speed).is_none()
+}

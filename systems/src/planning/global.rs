@@ -1,0 +1,135 @@
+//! Global trajectories (EAAE step 6): a path search on the inflated grid, shortened by line of
+//! sight, turned into a minimum-snap trajectory (Richter, Bry & Roy 2013; `crate::trajectory`)
+//! that is dynamically feasible (|v| <= vmax, |a| <= amax everywhere, by the time allocation of
+//! `plan_min_snap`) and stays in traversable space (every sample, see [`super::check`]).
+//!
+//! When the polynomial leaves traversable space (it bulges off the straight chords at corners),
+//! a waypoint is added to the segment where it does: the middle one of the original path's
+//! points that the shortening dropped there, or, when there are none, the midpoint of the
+//! segment's chord (Richter et al. §IV), and the problem is solved again, times re-allocated.
+//! With every original point back in, the polynomial is pinned to lattice points 0.2 to 0.35 m
+//! apart, all in traversable space; chord midpoints then halve what is left.
+//!
+//! Headings face the direction of travel at every waypoint (the depth camera looks forward,
+//! where the UAV is going), and `end_yaw` at the end when given.
+
+use super::check::first_untraversable;
+use super::search::{MIN_POINT_SEPARATION_M, find_path, path_length, shortcut_indices};
+use super::traversable::TraversableGrid;
+use crate::behaviour::waypoints::follow_headings;
+use crate::trajectory::{DynamicLimits, PlanError, Waypoint, plan_min_snap};
+use glam::DVec3;
+use uavex_components::trajectory::{PiecewisePolynomial, TrajectoryPoint};
+
+/// A planned global trajectory and the path it follows.
+#[derive(Debug, Clone, PartialEq)]
+pub struct GlobalPlan {
+    /// The shortened path, from the start position to the end.
+    pub path: Vec<DVec3>,
+    /// Length of `path` (m).
+    pub path_length_m: f64,
+    pub trajectory: PiecewisePolynomial,
+}
+
+/// A dynamically feasible, collision-free minimum-snap trajectory from `start` (which may be
+/// moving) along `path` (e.g. from [`super::find_paths`]; its leading points within 1 cm of
+/// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
+/// direction of the last leg). Waypoints are added until every sample is traversable (module
+/// doc); `Err(Collision)` when that does not converge, `Err(NoWaypoints)` when the path does
+/// not leave the start.
+pub fn plan_along(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
+    path: &[DVec3],
+    end_yaw: Option<f64>,
+    limits: &DynamicLimits,
+) -> Result<GlobalPlan, PlanError> {
+    if let Some(i) = path.iter().position(|p| !p.is_finite()) {
+        return Err(PlanError::NonFinite(format!("path point {i}")));
+    }
+    let skip = path
+        .iter()
+        .take_while(|p| p.distance(start.position) < MIN_POINT_SEPARATION_M)
+        .count();
+    let mut original = Vec::with_capacity(path.len() + 1);
+    original.push(start.position);
+    original.extend_from_slice(&path[skip..]);
+    if original.len() < 2 {
+        return Err(PlanError::NoWaypoints);
+    }
+    let kept = shortcut_indices(grid, &original);
+    let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
+    let trajectory = fit(grid, start, &original, &kept, end_yaw, limits)?;
+    Ok(GlobalPlan {
+        path_length_m: path_length(&shortened),
+        path: shortened,
+        trajectory,
+    })
+}
+
+/// [`find_path`] from the start's position to `goal`, then [`plan_along`].
+pub fn plan_global(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
+    goal: DVec3,
+    end_yaw: Option<f64>,
+    limits: &DynamicLimits,
+) -> Result<GlobalPlan, PlanError> {
+    let path =
+        find_path(grid, start.position, goal, usize::MAX).ok_or(PlanError::NoPath { goal })?;
+    plan_along(grid, start, &path, end_yaw, limits)
+}
+
+/// The minimum-snap fit through the kept points of `original`, with waypoints added where it
+/// leaves traversable space (module doc).
+fn fit(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
+    original: &[DVec3],
+    kept: &[usize],
+    end_yaw: Option<f64>,
+    limits: &DynamicLimits,
+) -> Result<PiecewisePolynomial, PlanError> {
+    // Waypoints (the start excluded) and the index in `original` each came from, if any.
+    let mut positions: Vec<DVec3> = kept[1..].iter().map(|&i| original[i]).collect();
+    let mut origins: Vec<Option<usize>> = kept[1..].iter().map(|&i| Some(i)).collect();
+    let attempts = 4 * original.len() + 16;
+    for _ in 0..attempts {
+        let mut yaws = follow_headings(start.position, start.yaw, &positions);
+        if let (Some(yaw), Some(last)) = (end_yaw, yaws.last_mut()) {
+            *last = yaw;
+        }
+        let waypoints: Vec<Waypoint> = positions
+            .iter()
+            .zip(&yaws)
+            .map(|(&position, &yaw)| Waypoint {
+                position,
+                yaw: Some(yaw),
+            })
+            .collect();
+        let trajectory = plan_min_snap(start, &waypoints, limits)?;
+        let Some((time_s, position)) =
+            first_untraversable(grid, &trajectory, 0.0, limits.max_velocity)
+        else {
+            return Ok(trajectory);
+        };
+        let (segment, _) = trajectory.locate(time_s);
+        let (from, from_origin) = if segment == 0 {
+            (start.position, Some(0))
+        } else {
+            (positions[segment - 1], origins[segment - 1])
+        };
+        let (point, origin) = match (from_origin, origins[segment]) {
+            (Some(a), Some(b)) if b > a + 1 => (original[(a + b) / 2], Some((a + b) / 2)),
+            _ => (0.5 * (from + positions[segment]), None),
+        };
+        let separated = point.distance(from) >= MIN_POINT_SEPARATION_M
+            && point.distance(positions[segment]) >= MIN_POINT_SEPARATION_M;
+        if !separated || !grid.is_traversable_point(point) {
+            return Err(PlanError::Collision { time_s, position });
+        }
+        positions.insert(segment, point);
+        origins.insert(segment, origin);
+    }
+    Err(PlanError::LimitsUnreachable)
+}

@@ -1,0 +1,59 @@
+//! Trajectory planning on the voxel map (EAAE steps 6 and 9).
+//!
+//! - [`traversable`]: the map's known free space shrunk by the UAV's radius, kept per chunk and
+//!   refreshed lazily where the map changed ([`TraversableGrid`]).
+//! - [`lattice`]: the 2-voxel search lattice over it.
+//! - [`search`]: A* ([`find_path`]), one Dijkstra to many goals ([`find_paths`]), and the
+//!   line-of-sight [`shortcut`].
+//! - [`global`]: a feasible, collision-free minimum-snap trajectory along a path
+//!   ([`plan_along`], [`plan_global`]).
+//! - [`local`]: the receding-horizon planner that flies toward the chosen goal ([`plan_local`]).
+//! - [`check`]: whether a trajectory stays traversable ([`remains_traversable`]).
+//!
+//! ECS: the grid is the resource [`Traversability`]; [`track_traversability`] (Frontier stage)
+//! marks the chunks the map stage changed dirty, and the systems that plan call
+//! `grid.0.refresh(&map)` before they search, so the grid is recomputed only where the map
+//! changed and only when someone needs it.
+
+pub mod check;
+pub mod global;
+pub mod lattice;
+pub mod local;
+pub mod search;
+pub mod traversable;
+
+#[cfg(test)]
+mod tests;
+#[cfg(test)]
+mod tests_planner;
+
+pub use check::{first_untraversable, remains_traversable};
+pub use global::{GlobalPlan, plan_along, plan_global};
+pub use local::{LocalPlan, plan_local};
+pub use search::{SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
+pub use traversable::TraversableGrid;
+
+use bevy_ecs::prelude::*;
+use uavex_components::map::{ChunkCoord, VoxelChunk};
+
+/// The traversability grid of the shared map, as a resource.
+#[derive(Resource, Debug, Clone)]
+pub struct Traversability(pub TraversableGrid);
+
+/// Frontier stage: marks every map chunk changed since this system last ran (and the chunks
+/// its inflation reaches) dirty in the [`Traversability`] grid. Does nothing while the
+/// resource is absent (runs that do not plan on the map).
+pub fn track_traversability(
+    grid: Option<ResMut<Traversability>>,
+    changed: Query<&ChunkCoord, Changed<VoxelChunk>>,
+) {
+    let Some(mut grid) = grid else {
+        return;
+    };
+    if changed.is_empty() {
+        return;
+    }
+    for coord in &changed {
+        grid.0.mark_changed(*coord);
+    }
+}

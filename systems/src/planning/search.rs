@@ -1,0 +1,338 @@
+//! Path search on the traversability grid (EAAE step 6: "A* or JPS on the voxel grid with
+//! obstacle inflation"): A* to one goal, one Dijkstra to many goals (every frontier cluster in
+//! one search), and the line-of-sight shortening of the result.
+//!
+//! The searches run on the 2-voxel lattice of [`super::lattice`] (why: see there), 26-connected
+//! with Euclidean move costs. Paths are returned in world coordinates: the query point, the
+//! centres of the cells visited, and the goal.
+//!
+//! End points: a point whose voxel is not traversable (tracking error, a UAV or a viewpoint
+//! close to a wall) is attached to the nearest open cell within [`SNAP_RADIUS_M`]; the path
+//! then starts there with a leg out of the blocked voxel (a start), or ends at that cell's
+//! centre (a goal). A traversable point is attached to the nearest open cell it sees (straight
+//! line over traversable voxels). Determinism: candidates are ordered by distance, then by
+//! cell index; the queue pops by cost, last in first out among equal costs, and moves are
+//! tried in a fixed order; no hash map is iterated.
+
+use super::lattice::Lattice;
+use super::traversable::TraversableGrid;
+use glam::{DVec3, IVec3};
+
+/// How far (m) a blocked start or goal may be moved to reach the lattice.
+pub const SNAP_RADIUS_M: f64 = 0.5;
+/// Points closer than this (m) along a path are merged (the trajectory planner refuses
+/// coincident waypoints).
+pub const MIN_POINT_SEPARATION_M: f64 = 0.01;
+
+const NONE: u32 = u32::MAX;
+
+/// Where a query point joins the lattice.
+#[derive(Debug, Clone, Copy)]
+struct Endpoint {
+    point: DVec3,
+    cell: usize,
+    /// Whether `point` itself is traversable (it is then part of the path).
+    traversable: bool,
+}
+
+fn attach(grid: &TraversableGrid, point: DVec3) -> Option<Endpoint> {
+    let lattice = grid.lattice();
+    if !point.is_finite() || !lattice.is_available() {
+        return None;
+    }
+    let resolution = grid.resolution();
+    let traversable = grid.is_traversable_point(point);
+    let home = Lattice::cell_of_key(grid.key_of(point));
+    let n = (SNAP_RADIUS_M / (2.0 * resolution)).ceil() as i32 + 1;
+    let mut candidates = Vec::new();
+    for dz in -n..=n {
+        for dy in -n..=n {
+            for dx in -n..=n {
+                let cell = home + IVec3::new(dx, dy, dz);
+                let Some(index) = lattice.index(cell) else {
+                    continue;
+                };
+                if !lattice.is_open(index) {
+                    continue;
+                }
+                let centre = lattice.centre(cell, resolution);
+                let distance = centre.distance(point);
+                if distance <= SNAP_RADIUS_M {
+                    candidates.push((distance, index, centre));
+                }
+            }
+        }
+    }
+    candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    candidates
+        .into_iter()
+        .find(|&(_, _, centre)| !traversable || grid.line_of_sight(point, centre))
+        .map(|(_, cell, _)| Endpoint {
+            point,
+            cell,
+            traversable,
+        })
+}
+
+/// Appends `p`, merging it with the last point when closer than [`MIN_POINT_SEPARATION_M`]
+/// (the first point, the query's start, is never replaced).
+fn push_point(path: &mut Vec<DVec3>, p: DVec3) {
+    match path.last() {
+        Some(last) if last.distance(p) < MIN_POINT_SEPARATION_M => {
+            if path.len() > 1 {
+                *path.last_mut().expect("non-empty") = p;
+            }
+        }
+        _ => path.push(p),
+    }
+}
+
+fn assemble(grid: &TraversableGrid, from: &Endpoint, cells: &[usize], to: &Endpoint) -> Vec<DVec3> {
+    let lattice = grid.lattice();
+    let mut path = Vec::with_capacity(cells.len() + 2);
+    path.push(from.point);
+    for &cell in cells {
+        push_point(
+            &mut path,
+            lattice.centre(lattice.cell(cell), grid.resolution()),
+        );
+    }
+    if to.traversable {
+        push_point(&mut path, to.point);
+    }
+    path
+}
+
+/// Cells from the start to `goal` by following `parent`.
+fn trace(parent: &[u32], goal: usize) -> Vec<usize> {
+    let mut cells = vec![goal];
+    let mut at = goal;
+    while parent[at] != NONE {
+        at = parent[at] as usize;
+        cells.push(at);
+    }
+    cells.reverse();
+    cells
+}
+
+/// Slots of the bucket queue: more than the largest key step, `2 x` the largest move cost
+/// for A* (a move raises g by its cost and changes h by at most as much).
+const BUCKETS: usize = 4096;
+
+/// Dial's bucket queue: keys pop in non-decreasing order, and every key pushed lies within
+/// [`BUCKETS`] of the last key popped. Within a key, last in first out (for A*, the deeper
+/// node first, which keeps it on the straight line in open space).
+struct BucketQueue {
+    buckets: Vec<Vec<u32>>,
+    current: u64,
+    len: usize,
+}
+
+impl BucketQueue {
+    fn new() -> Self {
+        Self {
+            buckets: vec![Vec::new(); BUCKETS],
+            current: 0,
+            len: 0,
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, key: u64, node: usize) {
+        self.buckets[key as usize % BUCKETS].push(node as u32);
+        self.len += 1;
+    }
+
+    #[inline]
+    fn pop(&mut self) -> Option<usize> {
+        if self.len == 0 {
+            return None;
+        }
+        loop {
+            if let Some(node) = self.buckets[self.current as usize % BUCKETS].pop() {
+                self.len -= 1;
+                return Some(node as usize);
+            }
+            self.current += 1;
+        }
+    }
+}
+
+/// The state of one search over the lattice.
+struct Search {
+    cost: Vec<u64>,
+    parent: Vec<u32>,
+    closed: Vec<bool>,
+}
+
+/// Best-first search from `start` (Dijkstra, or with `ASTAR` A* toward `target` with the octile
+/// heuristic), calling `settled` on every cell as it is closed (in order of cost) until it
+/// returns true, the reachable space is exhausted, or `max_expansions` cells were expanded.
+fn explore<const ASTAR: bool>(
+    lattice: &Lattice,
+    start: usize,
+    target: IVec3,
+    max_expansions: usize,
+    mut settled: impl FnMut(usize) -> bool,
+) -> Search {
+    let n = lattice.len();
+    let mut search = Search {
+        cost: vec![u64::MAX; n],
+        parent: vec![NONE; n],
+        closed: vec![false; n],
+    };
+    let heuristic = |cell: IVec3| {
+        if ASTAR {
+            Lattice::heuristic(cell, target)
+        } else {
+            0
+        }
+    };
+    let mut queue = BucketQueue::new();
+    search.cost[start] = 0;
+    let start_cell = lattice.cell(start);
+    queue.current = heuristic(start_cell);
+    queue.push(queue.current, start);
+    let mut expansions = 0usize;
+    while let Some(index) = queue.pop() {
+        if search.closed[index] {
+            continue;
+        }
+        search.closed[index] = true;
+        if settled(index) {
+            break;
+        }
+        expansions += 1;
+        if expansions > max_expansions {
+            break;
+        }
+        let g = search.cost[index];
+        let cell = if ASTAR {
+            lattice.cell(index)
+        } else {
+            IVec3::ZERO
+        };
+        let open = lattice.open_neighbours(index);
+        for mv in lattice.moves() {
+            if open & mv.box_mask != mv.box_mask {
+                continue;
+            }
+            let next = index.wrapping_add_signed(mv.offset);
+            let g_next = g + mv.cost;
+            // A closed cell already has a cost <= g (consistent heuristic): no closed check.
+            if g_next < search.cost[next] {
+                search.cost[next] = g_next;
+                search.parent[next] = index as u32;
+                queue.push(g_next + heuristic(cell + mv.delta), next);
+            }
+        }
+    }
+    search
+}
+
+/// Shortest path (A*, 26-connected, Euclidean costs, octile heuristic, which is admissible and
+/// consistent) from `from` to `to`, or `None` when there is none or more than `max_expansions`
+/// cells would have to be expanded. The path starts at `from`, passes cell centres, and ends at
+/// `to` (or where a blocked `to` was attached, see the module doc).
+pub fn find_path(
+    grid: &TraversableGrid,
+    from: DVec3,
+    to: DVec3,
+    max_expansions: usize,
+) -> Option<Vec<DVec3>> {
+    let start = attach(grid, from)?;
+    let goal = attach(grid, to)?;
+    let lattice = grid.lattice();
+    let target = lattice.cell(goal.cell);
+    let search = explore::<true>(lattice, start.cell, target, max_expansions, |cell| {
+        cell == goal.cell
+    });
+    search.closed[goal.cell].then(|| {
+        let cells = trace(&search.parent, goal.cell);
+        assemble(grid, &start, &cells, &goal)
+    })
+}
+
+/// Shortest paths from `from` to every goal with one Dijkstra search, which stops when every
+/// goal's cell is settled, the reachable space is exhausted, or `max_expansions` cells were
+/// expanded. `result[i]` is the path to `goals[i]` (as [`find_path`] returns it; equal in
+/// length, ties may pick another of the equally short paths), or `None`.
+pub fn find_paths(
+    grid: &TraversableGrid,
+    from: DVec3,
+    goals: &[DVec3],
+    max_expansions: usize,
+) -> Vec<Option<Vec<DVec3>>> {
+    let mut result = vec![None; goals.len()];
+    let Some(start) = attach(grid, from) else {
+        return result;
+    };
+    let ends: Vec<Option<Endpoint>> = goals.iter().map(|&g| attach(grid, g)).collect();
+    let mut targets: Vec<usize> = ends.iter().flatten().map(|e| e.cell).collect();
+    targets.sort_unstable();
+    targets.dedup();
+    if targets.is_empty() {
+        return result;
+    }
+    let mut remaining = targets.len();
+    let search = explore::<false>(
+        grid.lattice(),
+        start.cell,
+        IVec3::ZERO,
+        max_expansions,
+        |cell| {
+            if targets.binary_search(&cell).is_ok() {
+                remaining -= 1;
+            }
+            remaining == 0
+        },
+    );
+    for (slot, end) in result.iter_mut().zip(&ends) {
+        if let Some(end) = end
+            && search.closed[end.cell]
+        {
+            *slot = Some(assemble(
+                grid,
+                &start,
+                &trace(&search.parent, end.cell),
+                end,
+            ));
+        }
+    }
+    result
+}
+
+/// Indices of the points [`shortcut`] keeps.
+pub(crate) fn shortcut_indices(grid: &TraversableGrid, path: &[DVec3]) -> Vec<usize> {
+    if path.len() <= 2 {
+        return (0..path.len()).collect();
+    }
+    let last = path.len() - 1;
+    let mut kept = vec![0];
+    let mut anchor = 0;
+    for j in 1..last {
+        if !grid.line_of_sight(path[anchor], path[j + 1]) {
+            kept.push(j);
+            anchor = j;
+        }
+    }
+    kept.push(last);
+    kept
+}
+
+/// Line-of-sight shortening ("string pulling") of a path: from each kept point, the path's
+/// points are skipped as long as the straight chord to the next one crosses traversable voxels
+/// only. Every chord kept is such a chord, or one of the input's own legs (the first leg out
+/// of a blocked start, for instance, which no chord can replace). The first and last points
+/// are kept.
+pub fn shortcut(grid: &TraversableGrid, path: &[DVec3]) -> Vec<DVec3> {
+    shortcut_indices(grid, path)
+        .into_iter()
+        .map(|i| path[i])
+        .collect()
+}
+
+/// Length of a polyline (m).
+pub fn path_length(path: &[DVec3]) -> f64 {
+    path.windows(2).map(|w| w[0].distance(w[1])).sum()
+}

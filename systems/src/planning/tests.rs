@@ -1,0 +1,374 @@
+//! Tests of the traversability grid and the path searches, on hand-made maps.
+
+use super::*;
+use crate::mapping::{ChunkAccess, ChunkStore};
+use glam::{DVec3, IVec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use uavex_components::map::{ChunkCoord, MapConfig, MapSettings, local_index};
+
+/// Clamped free and occupied log-odds (common.md §1 defaults, milli units).
+pub(super) const FREE: i16 = -1992;
+pub(super) const OCCUPIED: i16 = 3476;
+
+/// A map written voxel by voxel.
+pub(super) struct TestMap {
+    pub store: ChunkStore,
+    pub config: MapConfig,
+}
+
+impl TestMap {
+    pub fn new(min: DVec3, max: DVec3) -> Self {
+        let config = MapConfig::new(&MapSettings {
+            resolution: 0.1,
+            bounds_min: min,
+            bounds_max: max,
+            ..MapSettings::default()
+        })
+        .unwrap();
+        Self {
+            store: ChunkStore::new(&config),
+            config,
+        }
+    }
+
+    pub fn set(&mut self, key: IVec3, log_odds: i16) {
+        assert!(self.config.contains_key(key));
+        let coord = ChunkCoord::of_key(key);
+        let flat = self.config.chunk_grid().flat(coord).unwrap();
+        self.store.chunk_mut(flat, coord).0.voxels_mut()[local_index(key)].log_odds = log_odds;
+        self.store.mark_written(flat);
+    }
+
+    /// Sets every voxel of the key box `lo..=hi` (clipped to the map).
+    pub fn fill(&mut self, lo: IVec3, hi: IVec3, log_odds: i16) {
+        let (lo, hi) = (lo.max(self.config.key_min()), hi.min(self.config.key_max()));
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    self.set(IVec3::new(x, y, z), log_odds);
+                }
+            }
+        }
+    }
+
+    pub fn fill_all(&mut self, log_odds: i16) {
+        self.fill(self.config.key_min(), self.config.key_max(), log_odds);
+    }
+
+    /// A grid refreshed from the chunks written since the last call.
+    pub fn update(&mut self, grid: &mut TraversableGrid) {
+        for coord in self.store.take_written() {
+            grid.mark_changed(coord);
+        }
+        grid.refresh(&self.store);
+    }
+
+    pub fn grid(&mut self, inflation_m: f64) -> TraversableGrid {
+        let mut grid = TraversableGrid::new(&self.config, inflation_m);
+        self.update(&mut grid);
+        grid
+    }
+}
+
+fn keys(config: &MapConfig, margin: i32) -> impl Iterator<Item = IVec3> {
+    let (lo, hi) = (
+        config.key_min() - IVec3::splat(margin),
+        config.key_max() + IVec3::splat(margin),
+    );
+    (lo.z..=hi.z).flat_map(move |z| {
+        (lo.y..=hi.y).flat_map(move |y| (lo.x..=hi.x).map(move |x| IVec3::new(x, y, z)))
+    })
+}
+
+/// The rule, by brute force: known free, and no occupied or out-of-box voxel with
+/// |d| <= radius (voxels).
+fn expected_traversable(map: &TestMap, key: IVec3, radius_voxels: f64) -> bool {
+    use crate::mapping::OccupancyMap;
+    if map.store.log_odds_milli(key).is_none_or(|l| l >= 0) {
+        return false;
+    }
+    let r = radius_voxels.floor() as i32;
+    for dz in -r..=r {
+        for dy in -r..=r {
+            for dx in -r..=r {
+                let d = IVec3::new(dx, dy, dz);
+                if f64::from(d.length_squared()) > radius_voxels * radius_voxels {
+                    continue;
+                }
+                let k = key + d;
+                let blocked = !map.config.contains_key(k)
+                    || map.store.log_odds_milli(k).is_some_and(|l| l >= 0);
+                if blocked {
+                    return false;
+                }
+            }
+        }
+    }
+    true
+}
+
+#[test]
+fn inflation_blocks_exactly_the_ball_and_the_box_border() {
+    // 3.2 m cube, keys 0..=31, all free but voxel (16, 16, 16); radius 0.2 m = 2 voxels.
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::splat(3.2));
+    map.fill_all(FREE);
+    map.set(IVec3::splat(16), OCCUPIED);
+    let grid = map.grid(0.2);
+    assert_eq!(grid.inflation_m(), 0.2);
+    let k = IVec3::new;
+    // At the radius (d^2 = 4, 3, 2) blocked; just beyond (d^2 = 5, 9) free.
+    for key in [
+        k(18, 16, 16),
+        k(17, 17, 17),
+        k(17, 17, 16),
+        k(16, 16, 16),
+        k(14, 16, 16),
+    ] {
+        assert!(!grid.is_traversable(key), "{key}");
+    }
+    for key in [k(19, 16, 16), k(18, 17, 16), k(16, 13, 16), k(18, 17, 17)] {
+        assert!(grid.is_traversable(key), "{key}");
+    }
+    // Out of box counts as occupied: key 1 is 2 voxels from key -1, key 2 is 3 away; at the
+    // top, 29 is 3 voxels from 32, 30 only 2.
+    assert!(!grid.is_traversable(k(1, 8, 8)));
+    assert!(grid.is_traversable(k(2, 8, 8)));
+    assert!(grid.is_traversable(k(8, 29, 8)));
+    assert!(!grid.is_traversable(k(8, 8, 30)));
+    assert!(!grid.is_traversable(k(-1, 8, 8)));
+    // Every key, against the rule: the traversable set is the box 2..=29 without the ball.
+    for key in keys(&map.config, 2) {
+        let inside = key.cmpge(IVec3::splat(2)).all() && key.cmple(IVec3::splat(29)).all();
+        let expected = inside && (key - IVec3::splat(16)).length_squared() > 4;
+        assert_eq!(grid.is_traversable(key), expected, "{key}");
+    }
+    // Points: the voxel holding them; non-finite points never.
+    assert!(grid.is_traversable_point(DVec3::new(1.95, 1.65, 1.65)));
+    assert!(!grid.is_traversable_point(DVec3::new(1.85, 1.65, 1.65)));
+    assert!(!grid.is_traversable_point(DVec3::new(f64::NAN, 1.0, 1.0)));
+}
+
+#[test]
+fn unknown_is_not_traversable_but_does_not_block() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::splat(1.6));
+    map.fill_all(FREE);
+    map.set(IVec3::splat(8), i16::MIN);
+    let grid = map.grid(0.2);
+    assert!(!grid.is_traversable(IVec3::splat(8)));
+    assert!(grid.is_traversable(IVec3::new(9, 8, 8)));
+    // A chunk never created holds nothing traversable.
+    let empty = TestMap::new(DVec3::ZERO, DVec3::splat(1.6)).grid(0.2);
+    assert!(keys(&map.config, 0).all(|k| !empty.is_traversable(k)));
+}
+
+#[test]
+fn random_maps_follow_the_rule_and_incremental_refresh_equals_scratch() {
+    // Negative keys and chunk borders: keys -11..=22 on x.
+    let mut map = TestMap::new(DVec3::new(-1.05, -0.3, 0.0), DVec3::new(2.3, 1.7, 1.2));
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut incremental = TraversableGrid::new(&map.config, 0.27);
+    let (lo, hi) = (map.config.key_min(), map.config.key_max());
+    for round in 0..6 {
+        // Free blobs, then occupied specks, then some voxels forgotten to unknown.
+        for _ in 0..40 {
+            let key = IVec3::new(
+                rng.random_range(lo.x..=hi.x),
+                rng.random_range(lo.y..=hi.y),
+                rng.random_range(lo.z..=hi.z),
+            );
+            let value = match rng.random_range(0..10) {
+                0..6 => FREE,
+                6..9 => OCCUPIED,
+                _ => i16::MIN,
+            };
+            let size = if value == FREE { 4 } else { 0 };
+            map.fill(key, key + IVec3::splat(size), value);
+        }
+        map.update(&mut incremental);
+        assert_eq!(incremental.dirty_chunks(), 0);
+        let mut scratch = TraversableGrid::new(&map.config, 0.27);
+        scratch.mark_all();
+        scratch.refresh(&map.store);
+        let mut traversable = 0;
+        for key in keys(&map.config, 1) {
+            let expected = expected_traversable(&map, key, 2.7);
+            assert_eq!(
+                incremental.is_traversable(key),
+                expected,
+                "round {round} {key}"
+            );
+            assert_eq!(scratch.is_traversable(key), expected, "round {round} {key}");
+            traversable += usize::from(expected);
+        }
+        assert!(traversable > 0);
+    }
+}
+
+#[test]
+fn lattice_cells_are_open_when_all_eight_voxels_are() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::splat(1.6));
+    map.fill_all(FREE);
+    let mut grid = map.grid(0.0);
+    let lattice = grid.lattice();
+    let open = |grid: &TraversableGrid, c: IVec3| {
+        let lattice = grid.lattice();
+        lattice.is_open(lattice.index(c).unwrap())
+    };
+    assert!(lattice.is_available());
+    assert!(open(&grid, IVec3::new(3, 3, 3)));
+    map.set(IVec3::new(7, 6, 7), FREE + 1992); // l = 0: occupied
+    map.update(&mut grid);
+    assert!(!open(&grid, IVec3::new(3, 3, 3)));
+    assert!(open(&grid, IVec3::new(4, 3, 3)));
+    assert!(grid.is_traversable(IVec3::new(6, 6, 7)));
+}
+
+/// A 6.4 x 6.4 x 1.6 m room, all free, with a wall at x 3.0..3.2 m from y = 0 to 4.0 m.
+pub(super) fn wall_room() -> TestMap {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 1.6));
+    map.fill_all(FREE);
+    map.fill(IVec3::new(30, 0, 0), IVec3::new(31, 39, 15), OCCUPIED);
+    map
+}
+
+#[test]
+fn a_star_goes_around_the_wall_by_the_shortest_lattice_path() {
+    let mut map = wall_room();
+    let grid = map.grid(0.0);
+    // Cells (5, 5, 3) to (25, 5, 3); the wall fills cell column x = 15 for y cells 0..=19.
+    // Without corner cutting the path passes (14, 20), (15, 20), (16, 20): 9 diagonals and
+    // 6 straight moves on each side, plus 2 straight moves across: 18 sqrt 2 + 14 cells.
+    let (from, to) = (DVec3::new(1.1, 1.1, 0.7), DVec3::new(5.1, 1.1, 0.7));
+    let path = find_path(&grid, from, to, usize::MAX).unwrap();
+    let expected = (18.0 * 2f64.sqrt() + 14.0) * 0.2;
+    assert!(
+        (path_length(&path) - expected).abs() < 1e-9,
+        "{}",
+        path_length(&path)
+    );
+    assert_eq!((path[0], *path.last().unwrap()), (from, to));
+    // Every leg crosses traversable voxels only.
+    assert!(path.windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    // The shortened path: chords of sight only, no longer than the lattice path, no shorter
+    // than the way around the wall's end (1.1, 1.1) -> (3.0, 4.0) -> (3.2, 4.0) -> (5.1, 1.1).
+    let short = shortcut(&grid, &path);
+    assert!(short.windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    let around = 2.0 * (1.9f64.powi(2) + 2.9f64.powi(2)).sqrt() + 0.2;
+    let length = path_length(&short);
+    assert!(around <= length && length < expected, "{length}");
+    assert!(short.len() < path.len());
+    // In the open, the shortened path is the straight chord.
+    let open = find_path(
+        &grid,
+        DVec3::new(4.1, 5.1, 0.7),
+        DVec3::new(6.1, 0.5, 1.3),
+        10_000,
+    );
+    assert_eq!(shortcut(&grid, &open.unwrap()).len(), 2);
+}
+
+#[test]
+fn enclosed_goals_and_limits_give_none() {
+    let mut map = wall_room();
+    // A hollow box around (1.1 .. 1.4 m): occupied shell, free inside.
+    map.fill(IVec3::new(5, 5, 2), IVec3::new(20, 20, 13), OCCUPIED);
+    map.fill(IVec3::new(6, 6, 3), IVec3::new(19, 19, 12), FREE);
+    let grid = map.grid(0.0);
+    let inside = DVec3::new(1.3, 1.3, 0.7);
+    let outside = DVec3::new(5.1, 1.1, 0.7);
+    assert!(grid.is_traversable_point(inside));
+    assert_eq!(find_path(&grid, outside, inside, usize::MAX), None);
+    assert_eq!(find_path(&grid, inside, outside, usize::MAX), None);
+    // Reachable, but not within 10 expansions.
+    let far = DVec3::new(5.1, 5.1, 0.7);
+    assert!(find_path(&grid, outside, far, usize::MAX).is_some());
+    assert_eq!(find_path(&grid, outside, far, 10), None);
+    let both = find_paths(&grid, outside, &[inside, far, DVec3::NAN], usize::MAX);
+    assert_eq!(
+        (both[0].is_none(), both[1].is_some(), both[2].is_none()),
+        (true, true, true)
+    );
+}
+
+#[test]
+fn find_paths_agrees_with_find_path_on_random_maps() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for _ in 0..3 {
+        let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 2.4));
+        map.fill_all(FREE);
+        for _ in 0..12 {
+            let lo = IVec3::new(rng.random_range(0..60), rng.random_range(0..60), 0);
+            let size = IVec3::new(rng.random_range(2..14), rng.random_range(2..14), 23);
+            map.fill(lo, lo + size, OCCUPIED);
+        }
+        let grid = map.grid(0.27);
+        let random_point = |rng: &mut ChaCha8Rng| {
+            DVec3::new(
+                rng.random_range(0.0..6.4),
+                rng.random_range(0.0..6.4),
+                rng.random_range(0.0..2.4),
+            )
+        };
+        let from = (0..1000)
+            .map(|_| random_point(&mut rng))
+            .find(|&p| grid.is_traversable_point(p))
+            .unwrap();
+        let goals: Vec<DVec3> = (0..12).map(|_| random_point(&mut rng)).collect();
+        let many = find_paths(&grid, from, &goals, usize::MAX);
+        let mut found = 0;
+        for (goal, path) in goals.iter().zip(&many) {
+            let single = find_path(&grid, from, *goal, usize::MAX);
+            assert_eq!(single.is_some(), path.is_some(), "{goal}");
+            if let (Some(a), Some(b)) = (single, path) {
+                assert!((path_length(&a) - path_length(b)).abs() < 1e-6);
+                assert_eq!((a[0], a.last()), (b[0], b.last()));
+                found += 1;
+            }
+        }
+        assert!(found > 0);
+    }
+}
+
+#[test]
+fn a_blocked_start_is_attached_to_the_nearest_open_cell() {
+    let mut map = wall_room();
+    let grid = map.grid(0.27);
+    // 0.2 m from the wall's face (x = 3.0): inside the inflation.
+    let start = DVec3::new(2.85, 1.0, 0.8);
+    assert!(!grid.is_traversable_point(start));
+    let path = find_path(&grid, start, DVec3::new(1.0, 1.0, 0.8), usize::MAX).unwrap();
+    assert_eq!(path[0], start);
+    assert!(path[1].distance(start) <= SNAP_RADIUS_M);
+    assert!(path[1..].windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    // A goal inside the inflation ends at the nearest open cell's centre instead.
+    let path = find_path(&grid, DVec3::new(1.0, 1.0, 0.8), start, usize::MAX).unwrap();
+    let end = *path.last().unwrap();
+    assert!(grid.is_traversable_point(end) && end.distance(start) <= SNAP_RADIUS_M);
+    // Far outside the map: no open cell within reach.
+    assert_eq!(
+        find_path(&grid, DVec3::new(8.0, 1.0, 0.8), end, usize::MAX),
+        None
+    );
+}
+
+#[test]
+fn the_ecs_system_marks_changed_chunks_dirty() {
+    use bevy_ecs::prelude::*;
+    use uavex_components::map::VoxelChunk;
+    let map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 1.6));
+    let mut world = World::new();
+    world.insert_resource(Traversability(TraversableGrid::new(&map.config, 0.27)));
+    world.spawn((VoxelChunk::new(), ChunkCoord(IVec3::new(1, 1, 0))));
+    let mut schedule = Schedule::default();
+    schedule.add_systems(track_traversability);
+    schedule.run(&mut world);
+    // Chunk (1, 1, 0) and its neighbours in a 4 x 4 x 1 chunk grid: 3 x 3 x 1.
+    assert_eq!(world.resource::<Traversability>().0.dirty_chunks(), 9);
+    // Nothing changed since: nothing more to mark; without the resource, nothing happens.
+    world.resource_mut::<Traversability>().0.refresh(&map.store);
+    schedule.run(&mut world);
+    assert_eq!(world.resource::<Traversability>().0.dirty_chunks(), 0);
+    world.remove_resource::<Traversability>();
+    schedule.run(&mut world);
+}

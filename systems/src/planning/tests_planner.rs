@@ -1,0 +1,262 @@
+//! Tests of the global and local trajectory planners.
+
+use super::tests::{FREE, OCCUPIED, TestMap, wall_room};
+use super::*;
+use crate::trajectory::DynamicLimits;
+use crate::trajectory::limits::segment_peaks;
+use glam::{DVec3, IVec3};
+use proptest::prelude::*;
+use uavex_components::airframe::Airframe;
+use uavex_components::trajectory::{PiecewisePolynomial, Trajectory, TrajectoryPoint};
+
+fn kingfisher() -> DynamicLimits {
+    DynamicLimits::of(&Airframe::kingfisher())
+}
+
+/// Every 0.05 m of the trajectory is traversable (no escape allowance) and the peaks hold the
+/// limits; returns the end point.
+fn assert_safe(grid: &TraversableGrid, trajectory: &PiecewisePolynomial, limits: &DynamicLimits) {
+    let step = 0.05 / limits.max_velocity;
+    let n = (trajectory.duration() / step).ceil() as usize;
+    for i in 0..=n {
+        let t = (i as f64 * step).min(trajectory.duration());
+        let p = trajectory.sample(t).position;
+        assert!(
+            grid.is_traversable_point(p),
+            "t = {t}: {p} is not traversable"
+        );
+    }
+    for (v, a) in segment_peaks(trajectory) {
+        assert!(v <= limits.max_velocity * (1.0 + 1e-6), "speed {v}");
+        assert!(
+            a <= limits.max_acceleration * (1.0 + 1e-6),
+            "acceleration {a}"
+        );
+    }
+}
+
+fn end_of(trajectory: &PiecewisePolynomial) -> TrajectoryPoint {
+    trajectory.sample(trajectory.duration())
+}
+
+#[test]
+fn the_global_plan_goes_around_the_wall_within_the_limits() {
+    let mut map = wall_room();
+    let grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(1.1, 1.1, 0.7), 0.0);
+    let goal = DVec3::new(5.1, 1.1, 0.7);
+    let plan = plan_global(&grid, &start, goal, Some(1.0), &limits).unwrap();
+    assert_safe(&grid, &plan.trajectory, &limits);
+    let end = end_of(&plan.trajectory);
+    assert!(end.position.distance(goal) < 1e-9 && end.velocity.length() < 1e-9);
+    assert!((end.yaw - 1.0).abs() < 1e-9);
+    assert_eq!(
+        (plan.path[0], *plan.path.last().unwrap()),
+        (start.position, goal)
+    );
+    assert!((plan.path_length_m - path_length(&plan.path)).abs() < 1e-12);
+    // Around the wall's inflated end (y >= 4.0 + 0.27): longer than the straight 4 m.
+    assert!(plan.path_length_m > 2.0 * (1.9f64.powi(2) + 3.17f64.powi(2)).sqrt());
+    // From a moving start (1 m/s along +y) as well.
+    let moving = TrajectoryPoint {
+        velocity: DVec3::new(0.0, 1.0, 0.0),
+        ..start
+    };
+    let plan = plan_global(&grid, &moving, goal, None, &limits).unwrap();
+    assert_safe(&grid, &plan.trajectory, &limits);
+    assert!(remains_traversable(
+        &grid,
+        &plan.trajectory,
+        0.0,
+        limits.max_velocity
+    ));
+}
+
+#[test]
+fn unreachable_goals_and_bad_input_are_errors() {
+    let mut map = wall_room();
+    map.fill(IVec3::new(40, 0, 0), IVec3::new(41, 63, 15), OCCUPIED);
+    let grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(1.1, 1.1, 0.7), 0.0);
+    let goal = DVec3::new(5.1, 1.1, 0.7);
+    assert_eq!(
+        plan_global(&grid, &start, goal, None, &limits),
+        Err(crate::trajectory::PlanError::NoPath { goal })
+    );
+    assert!(plan_along(&grid, &start, &[start.position], None, &limits).is_err());
+    assert!(plan_along(&grid, &start, &[DVec3::NAN], None, &limits).is_err());
+    assert!(plan_local(&grid, &start, goal, None, f64::NAN, &limits).is_err());
+}
+
+/// An open room 10.4 x 6.4 x 2.4 m, all free.
+fn open_room() -> TestMap {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(10.4, 6.4, 2.4));
+    map.fill_all(FREE);
+    map
+}
+
+#[test]
+fn the_local_plan_stops_at_the_horizon_and_reaches_a_near_goal() {
+    let mut map = open_room();
+    let grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(1.1, 3.1, 1.1), 0.0);
+    // 8 m straight ahead, horizon 3 m: the plan ends at rest 3 m along the line.
+    let far = plan_local(
+        &grid,
+        &start,
+        DVec3::new(9.1, 3.1, 1.1),
+        Some(2.0),
+        3.0,
+        &limits,
+    )
+    .unwrap();
+    assert!(!far.reaches_goal);
+    let end = end_of(&far.trajectory);
+    assert!(
+        end.position.distance(DVec3::new(4.1, 3.1, 1.1)) < 1e-9,
+        "{}",
+        end.position
+    );
+    assert!(end.velocity.length() < 1e-9);
+    assert!(
+        end.yaw.abs() < 1e-9,
+        "faces the direction of travel, not the goal yaw"
+    );
+    assert_safe(&grid, &far.trajectory, &limits);
+    // 2 m ahead: reached, with the goal's heading.
+    let goal = DVec3::new(3.1, 3.1, 1.1);
+    let near = plan_local(&grid, &start, goal, Some(2.0), 3.0, &limits).unwrap();
+    assert!(near.reaches_goal);
+    let end = end_of(&near.trajectory);
+    assert!(end.position.distance(goal) < 1e-9 && (end.yaw - 2.0).abs() < 1e-9);
+    assert_safe(&grid, &near.trajectory, &limits);
+}
+
+#[test]
+fn a_new_obstacle_on_the_trajectory_triggers_a_replan() {
+    let mut map = open_room();
+    let mut grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(1.1, 3.1, 1.1), 0.0);
+    let goal = DVec3::new(9.1, 3.1, 1.1);
+    let plan = plan_local(&grid, &start, goal, None, 7.5, &limits).unwrap();
+    assert!(remains_traversable(&grid, &plan.trajectory, 0.0, 5.0));
+    // A pillar appears at x = 6 m, on the line; the trajectory from t = 1 s collides.
+    map.fill(IVec3::new(58, 28, 0), IVec3::new(62, 34, 23), OCCUPIED);
+    map.update(&mut grid);
+    assert!(!remains_traversable(&grid, &plan.trajectory, 1.0, 5.0));
+    assert!(!remains_traversable(&grid, &plan.trajectory, 0.0, f64::NAN));
+    // The replan from the reference at t = 1 s goes around it.
+    let state = plan.trajectory.sample(1.0);
+    let replan = plan_local(&grid, &state, goal, None, 7.5, &limits).unwrap();
+    assert_safe(&grid, &replan.trajectory, &limits);
+}
+
+#[test]
+fn a_start_inside_the_inflation_escapes() {
+    let mut map = wall_room();
+    let grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(2.85, 1.0, 0.8), 0.0);
+    assert!(!grid.is_traversable_point(start.position));
+    let plan = plan_global(&grid, &start, DVec3::new(1.0, 2.0, 0.8), None, &limits).unwrap();
+    // Out of the inflation within 0.5 m, traversable from there on.
+    assert!(first_untraversable(&grid, &plan.trajectory, 0.0, 5.0).is_none());
+    let mut left = false;
+    let step = 0.05 / 5.0;
+    for i in 0..=(plan.trajectory.duration() / step).ceil() as usize {
+        let p = plan.trajectory.sample(i as f64 * step).position;
+        left |= grid.is_traversable_point(p);
+        assert!(left || p.distance(start.position) <= SNAP_RADIUS_M);
+        assert!(!left || grid.is_traversable_point(p));
+    }
+}
+
+/// Random box obstacles (pillars and floating blocks) in a 6.4 x 6.4 x 2.4 m room.
+fn random_map(boxes: &[(i32, i32, i32, i32, i32, i32)]) -> TestMap {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 2.4));
+    map.fill_all(FREE);
+    for &(x, y, z, sx, sy, sz) in boxes {
+        let lo = IVec3::new(x, y, z);
+        map.fill(lo, lo + IVec3::new(sx, sy, sz), OCCUPIED);
+    }
+    map
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// The planner never returns a trajectory through known-occupied (inflated) voxels: every
+    /// sample 0.05 m apart is traversable, and the speed and acceleration hold their limits.
+    #[test]
+    fn planned_trajectories_stay_traversable_and_feasible(
+        boxes in prop::collection::vec((0..60i32, 0..60i32, 0..20i32, 1..15i32, 1..15i32, 2..24i32), 1..14),
+        from in (0.3..6.1f64, 0.3..6.1f64, 0.3..2.1f64),
+        to in (0.3..6.1f64, 0.3..6.1f64, 0.3..2.1f64),
+        speed in (-1.0..1.0f64, -1.0..1.0f64),
+    ) {
+        let mut map = random_map(&boxes);
+        let grid = map.grid(0.27);
+        let limits = kingfisher();
+        let (from, to) = (DVec3::new(from.0, from.1, from.2), DVec3::new(to.0, to.1, to.2));
+        prop_assume!(grid.is_traversable_point(from));
+        let start = TrajectoryPoint {
+            velocity: DVec3::new(speed.0, speed.1, 0.0),
+            ..TrajectoryPoint::at_rest(from, 0.3)
+        };
+        if let Ok(plan) = plan_global(&grid, &start, to, None, &limits) {
+            assert_safe(&grid, &plan.trajectory, &limits);
+        }
+        if let Ok(plan) = plan_local(&grid, &start, to, None, 3.0, &limits) {
+            assert_safe(&grid, &plan.trajectory, &limits);
+        }
+    }
+}
+
+#[test]
+fn planning_succeeds_on_random_maps_whenever_a_path_exists() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    let limits = kingfisher();
+    let (mut paths, mut global, mut local) = (0, 0, 0);
+    for _ in 0..40 {
+        let boxes: Vec<_> = (0..rng.random_range(1..14))
+            .map(|_| {
+                (
+                    rng.random_range(0..60),
+                    rng.random_range(0..60),
+                    rng.random_range(0..20),
+                    rng.random_range(1..15),
+                    rng.random_range(1..15),
+                    rng.random_range(2..24),
+                )
+            })
+            .collect();
+        let mut map = random_map(&boxes);
+        let grid = map.grid(0.27);
+        let mut point = || loop {
+            let p = DVec3::new(
+                rng.random_range(0.3..6.1),
+                rng.random_range(0.3..6.1),
+                rng.random_range(0.3..2.1),
+            );
+            if grid.is_traversable_point(p) {
+                break p;
+            }
+        };
+        let (from, to) = (point(), point());
+        if find_path(&grid, from, to, usize::MAX).is_none() {
+            continue;
+        }
+        paths += 1;
+        let start = TrajectoryPoint::at_rest(from, 0.0);
+        global += usize::from(plan_global(&grid, &start, to, None, &limits).is_ok());
+        local += usize::from(plan_local(&grid, &start, to, None, 3.0, &limits).is_ok());
+    }
+    // Measured: 40 of 40 maps have a path, and both planners succeed on every one.
+    assert!(paths >= 30, "{paths}");
+    assert_eq!((global, local), (paths, paths));
+}

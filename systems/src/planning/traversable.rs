@@ -1,0 +1,448 @@
+//! Where the UAV may be: the occupancy map's known free space, shrunk by the UAV's radius
+//! (EAAE step 6, "A* or JPS on the voxel grid with obstacle inflation").
+//!
+//! Rules (decided for this project):
+//! - A voxel is **traversable** when it is known free (common.md §1: observed, l < 0) and no
+//!   known-occupied voxel lies within the inflation radius, measured Euclidean between voxel
+//!   centres (a voxel exactly at the radius counts as within, with a 1e-9 relative tolerance so
+//!   that 0.2 m at 0.1 m is 2 voxels whatever the rounding).
+//! - Voxels **outside the map box count as occupied** for inflation: the boxes hug the
+//!   enclosure walls, whose surface hits may fall just outside the box. (There is no ceiling in
+//!   the EAAE scenes; staying a radius below the box top is harmless.)
+//! - Unknown voxels are not traversable, but unknown voxels near a traversable one are allowed:
+//!   exploration has to fly along the frontier.
+//!
+//! The grid is kept per map chunk and never recomputed from scratch per query: a changed map
+//! chunk marks itself and the chunks the inflation reaches dirty ([`TraversableGrid::mark_changed`]),
+//! and [`TraversableGrid::refresh`] recomputes only those, when a planner needs the grid.
+//!
+//! One chunk's refresh: the occupied voxels of the chunk and a halo of `R = floor(radius /
+//! resolution)` voxels around it are gathered as bit rows along x; each row is dilated along x
+//! by every half-width the ball has, and a voxel's row is then blocked by the OR, over the
+//! ball's (dy, dz) rows, of the neighbouring row dilated by that row's half-width
+//! `floor(sqrt(R'^2 - dy^2 - dz^2))`. That is the exact Euclidean ball as a union of x-runs, in
+//! a few thousand word operations per chunk.
+
+use super::lattice::Lattice;
+use crate::mapping::OccupancyMap;
+use glam::{DVec3, IVec3};
+use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, floor_to_key};
+
+/// Largest inflation, in voxels: a chunk plus its halo must fit a 64-bit row (16 + 2 x 24).
+/// Larger radii are clamped (2.4 m at 0.1 m, far beyond any UAV).
+pub const MAX_INFLATION_VOXELS: i32 = 24;
+const EDGE: i32 = CHUNK_EDGE;
+const ROWS: usize = (CHUNK_EDGE * CHUNK_EDGE) as usize;
+
+/// Traversable flags of one chunk: `rows[y + 16 z]` bit `x` (local coordinates).
+type ChunkRows = [u16; ROWS];
+
+/// One row of the inflation ball: voxels at (dx, dy, dz) with |dx| <= half_width.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct BallRow {
+    dy: i32,
+    dz: i32,
+    half_width: i32,
+}
+
+/// The traversability of every voxel of a map, as of the last [`TraversableGrid::refresh`].
+#[derive(Debug, Clone)]
+pub struct TraversableGrid {
+    resolution: f64,
+    key_min: IVec3,
+    key_max: IVec3,
+    chunk_grid: ChunkGrid,
+    inflation_m: f64,
+    /// Inflation in whole voxels (the halo width).
+    reach: i32,
+    ball: Vec<BallRow>,
+    /// Per chunk, by flat index; `None` when nothing in it is traversable.
+    chunks: Vec<Option<Box<ChunkRows>>>,
+    dirty_flags: Vec<bool>,
+    dirty: Vec<usize>,
+    lattice: Lattice,
+    /// Halo occupancy rows, and the same dilated along x by 0..=reach.
+    occupied: Vec<u64>,
+    dilated: Vec<u64>,
+}
+
+impl TraversableGrid {
+    /// An empty grid (nothing traversable) for the map of `config`, inflating obstacles by
+    /// `inflation_m`. A negative or non-finite radius is taken as 0; radii above
+    /// [`MAX_INFLATION_VOXELS`] voxels are clamped to it ([`Self::inflation_m`] tells).
+    pub fn new(config: &MapConfig, inflation_m: f64) -> Self {
+        let resolution = config.resolution();
+        let max = f64::from(MAX_INFLATION_VOXELS) * resolution;
+        let inflation_m = if inflation_m.is_finite() && inflation_m > 0.0 {
+            inflation_m.min(max)
+        } else {
+            0.0
+        };
+        let (reach, ball) = ball_rows(inflation_m / resolution);
+        let chunk_grid = config.chunk_grid();
+        let n = chunk_grid.len();
+        let width = (EDGE + 2 * reach) as usize;
+        Self {
+            resolution,
+            key_min: config.key_min(),
+            key_max: config.key_max(),
+            chunk_grid,
+            inflation_m,
+            reach,
+            ball,
+            chunks: vec![None; n],
+            dirty_flags: vec![false; n],
+            dirty: Vec::new(),
+            lattice: Lattice::new(config.key_min(), config.key_max()),
+            occupied: vec![0; width * width],
+            dilated: vec![0; (reach as usize + 1) * width * width],
+        }
+    }
+
+    /// The inflation radius in use (m).
+    pub fn inflation_m(&self) -> f64 {
+        self.inflation_m
+    }
+
+    pub fn resolution(&self) -> f64 {
+        self.resolution
+    }
+
+    /// Whether this grid was built for a map of `config`'s geometry.
+    pub fn matches(&self, config: &MapConfig) -> bool {
+        self.resolution == config.resolution()
+            && self.key_min == config.key_min()
+            && self.key_max == config.key_max()
+    }
+
+    /// A map chunk changed: it and every chunk the inflation reaches from it become dirty.
+    /// Chunks outside the map's chunk grid are ignored.
+    pub fn mark_changed(&mut self, chunk: ChunkCoord) {
+        if self.chunk_grid.flat(chunk).is_none() {
+            return;
+        }
+        let span = (self.reach + EDGE - 1) / EDGE;
+        for dz in -span..=span {
+            for dy in -span..=span {
+                for dx in -span..=span {
+                    let neighbour = ChunkCoord(chunk.0 + IVec3::new(dx, dy, dz));
+                    if let Some(flat) = self.chunk_grid.flat(neighbour) {
+                        self.mark_flat(flat);
+                    }
+                }
+            }
+        }
+    }
+
+    /// Every chunk dirty (a grid created for a map that already holds chunks).
+    pub fn mark_all(&mut self) {
+        for flat in 0..self.chunk_grid.len() {
+            self.mark_flat(flat);
+        }
+    }
+
+    /// Number of chunks waiting for a refresh.
+    pub fn dirty_chunks(&self) -> usize {
+        self.dirty.len()
+    }
+
+    fn mark_flat(&mut self, flat: usize) {
+        if !self.dirty_flags[flat] {
+            self.dirty_flags[flat] = true;
+            self.dirty.push(flat);
+        }
+    }
+
+    /// Recomputes the dirty chunks from `map`. A map of another geometry (e.g. after a change
+    /// of resolution) rebuilds the grid from scratch for it, with the same inflation radius.
+    pub fn refresh(&mut self, map: &impl OccupancyMap) {
+        if !self.matches(map.config()) {
+            *self = Self::new(map.config(), self.inflation_m);
+            self.mark_all();
+        }
+        let mut dirty = std::mem::take(&mut self.dirty);
+        dirty.sort_unstable();
+        for &flat in &dirty {
+            self.dirty_flags[flat] = false;
+            self.refresh_chunk(map, flat);
+        }
+        dirty.clear();
+        self.dirty = dirty;
+    }
+
+    /// Whether voxel `key` is traversable (false outside the map).
+    #[inline]
+    pub fn is_traversable(&self, key: IVec3) -> bool {
+        if key.cmplt(self.key_min).any() || key.cmpgt(self.key_max).any() {
+            return false;
+        }
+        let flat = self.chunk_grid.flat_unchecked(ChunkCoord::of_key(key));
+        match &self.chunks[flat] {
+            Some(rows) => {
+                let l = key & (EDGE - 1);
+                rows[(l.y + EDGE * l.z) as usize] >> l.x & 1 == 1
+            }
+            None => false,
+        }
+    }
+
+    /// Whether the voxel holding `p` is traversable (false for non-finite points).
+    #[inline]
+    pub fn is_traversable_point(&self, p: DVec3) -> bool {
+        p.is_finite() && self.is_traversable(self.key_of(p))
+    }
+
+    /// Key of the voxel holding `p` (`floor(p / resolution)`, as the map's keys).
+    #[inline]
+    pub fn key_of(&self, p: DVec3) -> IVec3 {
+        floor_to_key(p / self.resolution)
+    }
+
+    /// The search lattice over this grid (see [`super::lattice`]).
+    pub fn lattice(&self) -> &Lattice {
+        &self.lattice
+    }
+
+    fn refresh_chunk(&mut self, map: &impl OccupancyMap, flat: usize) {
+        let coord = self.chunk_grid.coord(flat);
+        let first = coord.first_key();
+        let rows = match map.chunk(coord) {
+            Some(chunk) => {
+                let free = self.free_rows(chunk, first);
+                if free.iter().any(|&r| r != 0) {
+                    let blocked = self.blocked_rows(map, first);
+                    let mut rows = free;
+                    rows.iter_mut()
+                        .zip(blocked.iter())
+                        .for_each(|(r, b)| *r &= !b);
+                    rows.iter().any(|&r| r != 0).then_some(rows)
+                } else {
+                    None
+                }
+            }
+            None => None,
+        };
+        self.update_lattice(first, rows.as_ref());
+        match (&mut self.chunks[flat], rows) {
+            (Some(stored), Some(rows)) => **stored = rows,
+            (slot, rows) => *slot = rows.map(Box::new),
+        }
+    }
+
+    /// Known-free voxels of the chunk inside the map box, as rows.
+    fn free_rows(&self, chunk: &uavex_components::map::VoxelChunk, first: IVec3) -> ChunkRows {
+        let voxels = chunk.voxels();
+        let mut rows = [0u16; ROWS];
+        // Bits of x keys inside the box.
+        let mut x_mask = 0u16;
+        for lx in 0..EDGE {
+            let x = first.x + lx;
+            if (self.key_min.x..=self.key_max.x).contains(&x) {
+                x_mask |= 1 << lx;
+            }
+        }
+        for lz in 0..EDGE {
+            for ly in 0..EDGE {
+                let (y, z) = (first.y + ly, first.z + lz);
+                if !(self.key_min.y..=self.key_max.y).contains(&y)
+                    || !(self.key_min.z..=self.key_max.z).contains(&z)
+                {
+                    continue;
+                }
+                let row = (ly + EDGE * lz) as usize;
+                let base = row * EDGE as usize;
+                let mut bits = 0u16;
+                for lx in 0..EDGE as usize {
+                    // Free: known (not i16::MIN) with l < 0.
+                    let l = voxels[base + lx].log_odds;
+                    bits |= u16::from(l < 0 && l != i16::MIN) << lx;
+                }
+                rows[row] = bits & x_mask;
+            }
+        }
+        rows
+    }
+
+    /// Voxels of the chunk with a known-occupied (or out-of-box) voxel within the radius.
+    fn blocked_rows(&mut self, map: &impl OccupancyMap, first: IVec3) -> ChunkRows {
+        let r = self.reach;
+        let width = EDGE + 2 * r;
+        let w = width as usize;
+        let halo_min = first - IVec3::splat(r);
+        let halo_max = first + IVec3::splat(EDGE - 1 + r);
+        let all = if width == 64 {
+            u64::MAX
+        } else {
+            (1u64 << width) - 1
+        };
+        // Out-of-box voxels are occupied.
+        let mut outside_x = 0u64;
+        for hx in 0..width {
+            let x = halo_min.x + hx;
+            if !(self.key_min.x..=self.key_max.x).contains(&x) {
+                outside_x |= 1 << hx;
+            }
+        }
+        for hz in 0..width {
+            for hy in 0..width {
+                let key = halo_min + IVec3::new(0, hy, hz);
+                let in_yz = (self.key_min.y..=self.key_max.y).contains(&key.y)
+                    && (self.key_min.z..=self.key_max.z).contains(&key.z);
+                self.occupied[hy as usize + w * hz as usize] = if in_yz { outside_x } else { all };
+            }
+        }
+        // Known-occupied voxels (l >= 0) of every chunk the halo overlaps.
+        let (c_lo, c_hi) = (
+            ChunkCoord::of_key(halo_min).0,
+            ChunkCoord::of_key(halo_max).0,
+        );
+        for cz in c_lo.z..=c_hi.z {
+            for cy in c_lo.y..=c_hi.y {
+                for cx in c_lo.x..=c_hi.x {
+                    let coord = ChunkCoord(IVec3::new(cx, cy, cz));
+                    let Some(chunk) = map.chunk(coord) else {
+                        continue;
+                    };
+                    let voxels = chunk.voxels();
+                    let c_first = coord.first_key();
+                    let lo = halo_min.max(c_first).max(self.key_min);
+                    let hi = halo_max
+                        .min(c_first + IVec3::splat(EDGE - 1))
+                        .min(self.key_max);
+                    if lo.cmpgt(hi).any() {
+                        continue;
+                    }
+                    for z in lo.z..=hi.z {
+                        for y in lo.y..=hi.y {
+                            let local = ((y - c_first.y) + EDGE * (z - c_first.z)) * EDGE;
+                            let row = &mut self.occupied
+                                [(y - halo_min.y) as usize + w * (z - halo_min.z) as usize];
+                            let mut bits = 0u64;
+                            for x in lo.x..=hi.x {
+                                let l = voxels[(local + x - c_first.x) as usize].log_odds;
+                                bits |= u64::from(l >= 0) << (x - halo_min.x);
+                            }
+                            *row |= bits;
+                        }
+                    }
+                }
+            }
+        }
+        // Dilation along x by each half-width 0..=r.
+        let plane = w * w;
+        self.dilated[..plane].copy_from_slice(&self.occupied);
+        for s in 1..=r as usize {
+            for i in 0..plane {
+                let o = self.occupied[i];
+                self.dilated[s * plane + i] = self.dilated[(s - 1) * plane + i] | o << s | o >> s;
+            }
+        }
+        let mut blocked = [0u16; ROWS];
+        for lz in 0..EDGE {
+            for ly in 0..EDGE {
+                let mut bits = 0u64;
+                for row in &self.ball {
+                    let (hy, hz) = ((ly + r + row.dy) as usize, (lz + r + row.dz) as usize);
+                    bits |= self.dilated[row.half_width as usize * plane + hy + w * hz];
+                }
+                blocked[(ly + EDGE * lz) as usize] = (bits >> r) as u16;
+            }
+        }
+        blocked
+    }
+
+    /// Writes the chunk's cells into the lattice (a cell is open when all 8 voxels are).
+    fn update_lattice(&mut self, first: IVec3, rows: Option<&ChunkRows>) {
+        let first_cell = Lattice::cell_of_key(first);
+        let cells = EDGE / 2;
+        for cz in 0..cells {
+            for cy in 0..cells {
+                let m = rows.map_or(0, |rows| {
+                    let at = |y: i32, z: i32| rows[(y + EDGE * z) as usize];
+                    let (y, z) = (2 * cy, 2 * cz);
+                    let r = at(y, z) & at(y + 1, z) & at(y, z + 1) & at(y + 1, z + 1);
+                    r & (r >> 1)
+                });
+                for cx in 0..cells {
+                    let open = m >> (2 * cx) & 1 == 1;
+                    self.lattice.set(first_cell + IVec3::new(cx, cy, cz), open);
+                }
+            }
+        }
+    }
+
+    /// Whether every voxel from `a` to `b` (world points) on the straight segment is
+    /// traversable (the voxel traversal of `crate::mapping::dda`, 6-connected, so a segment
+    /// through an edge or corner also needs a voxel beside it).
+    pub fn line_of_sight(&self, a: DVec3, b: DVec3) -> bool {
+        if !(a.is_finite() && b.is_finite()) {
+            return false;
+        }
+        if !self.is_traversable_point(a) || !self.is_traversable_point(b) {
+            return false;
+        }
+        let (ua, ub) = (a / self.resolution, b / self.resolution);
+        let mut clear = true;
+        crate::mapping::dda::for_each_key(ua, ub, self.key_min, self.key_max, |key| {
+            clear &= self.is_traversable(key);
+        });
+        clear
+    }
+}
+
+/// The inflation ball as x-runs: the whole-voxel reach and every (dy, dz) row with its
+/// half-width, for a radius of `radius_voxels` voxels.
+fn ball_rows(radius_voxels: f64) -> (i32, Vec<BallRow>) {
+    let limit = radius_voxels * radius_voxels * (1.0 + 1e-9) + 1e-9;
+    let within = |d2: i32| f64::from(d2) <= limit;
+    let mut reach = 0;
+    while reach < MAX_INFLATION_VOXELS && within((reach + 1) * (reach + 1)) {
+        reach += 1;
+    }
+    let mut rows = Vec::new();
+    for dz in -reach..=reach {
+        for dy in -reach..=reach {
+            let yz = dy * dy + dz * dz;
+            if !within(yz) {
+                continue;
+            }
+            let mut half_width = 0;
+            while half_width < reach && within(yz + (half_width + 1) * (half_width + 1)) {
+                half_width += 1;
+            }
+            rows.push(BallRow { dy, dz, half_width });
+        }
+    }
+    (reach, rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ball_rows_of_two_voxels() {
+        // Radius 2: offsets with dx^2 + dy^2 + dz^2 <= 4. Rows (dy, dz): (0, 0) half-width 2;
+        // the four (+-1, 0), (0, +-1): 1 (1 + 1 <= 4, 1 + 4 > 4); the four (+-1, +-1): 1
+        // (2 + 1 <= 4); the four (+-2, 0), (0, +-2): 0. 13 rows, 33 voxels in the ball.
+        let (reach, rows) = ball_rows(2.0);
+        assert_eq!(reach, 2);
+        assert_eq!(rows.len(), 13);
+        let voxels: i32 = rows.iter().map(|r| 2 * r.half_width + 1).sum();
+        assert_eq!(voxels, 5 + 4 * 3 + 4 * 3 + 4);
+        // 0.2 m / 0.1 m is 2.0000000000000004 or 1.9999999999999998 depending on the path: the
+        // tolerance keeps the boundary voxel.
+        assert_eq!(ball_rows(1.999_999_999_999_999_8).0, 2);
+        assert_eq!(
+            ball_rows(0.0),
+            (
+                0,
+                vec![BallRow {
+                    dy: 0,
+                    dz: 0,
+                    half_width: 0
+                }]
+            )
+        );
+    }
+}

@@ -73,6 +73,10 @@ pub struct Explorer {
     pub settings: ExplorerSettings,
     pub home: Vec3,
     pub home_yaw: f32,
+    /// The capsule (segment and radius, m) at the start checked clear of obstacles, which the
+    /// planner takes as known free.
+    pub start_clear: [Vec3; 2],
+    pub start_clear_radius: f64,
 }
 
 /// Marker: the UAV needs a new goal; the Decide stage makes one this tick.

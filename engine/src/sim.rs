@@ -160,7 +160,15 @@ impl Sim {
                     let Some(physics) = physics.as_mut() else {
                         continue;
                     };
-                    match explorer_components(spec, index, airframe, physics, explore) {
+                    match explorer_components(
+                        spec,
+                        index,
+                        airframe,
+                        physics,
+                        explore,
+                        world.resource::<WorldGeometry>(),
+                        scenario.map.resolution,
+                    ) {
                         Ok((bundle, strategy)) => {
                             let mut entity = world.entity_mut(uav);
                             entity.insert(bundle);

@@ -14,6 +14,7 @@ use uavex_components::exploration::{EnergyBudget, Explorer, ExplorerSettings, Ne
 use uavex_components::frontier::ClusterSettings;
 use uavex_components::map::MapConfig;
 use uavex_components::trajectory::Hold;
+use uavex_components::world::WorldGeometry;
 use uavex_systems::behaviour::waypoints::CLEARANCE_MARGIN_M;
 use uavex_systems::exploration::strategy::{
     ClassicStrategy, EaaeStrategy, NearestStrategy, choose_largest_gain, choose_least_energy,
@@ -28,31 +29,117 @@ use uavex_systems::planning::{Traversability, TraversableGrid};
 /// The horizontal field of view (rad) and range (m) of the UAV's first depth camera: the
 /// clustering stop rule and the planning horizon are made for it (eaae.md steps 2 and 9).
 pub fn camera_of(spec: &UavSpec) -> Option<(f64, f64)> {
+    first_camera(spec).map(|c| (c.hfov, c.range_max))
+}
+
+/// What exploration needs to know of a camera.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct CameraView {
+    hfov: f64,
+    /// Vertical field of view (rad), from the aspect ratio (pinhole, common.md §2).
+    vfov: f64,
+    range_max: f64,
+}
+
+fn first_camera(spec: &UavSpec) -> Option<CameraView> {
     spec.sensors.iter().find_map(|sensor| match sensor {
         SensorSpec::DepthCamera {
-            hfov, range_max, ..
-        } => Some((*hfov, *range_max)),
+            hfov,
+            range_max,
+            width,
+            height,
+            ..
+        } => Some(CameraView {
+            hfov: *hfov,
+            vfov: 2.0 * ((hfov / 2.0).tan() * f64::from(*height) / f64::from(*width)).atan(),
+            range_max: *range_max,
+        }),
         SensorSpec::Lidar { .. } => None,
     })
 }
 
+/// The stretch ahead of an explorer's start that the planner takes as known free
+/// (`TraversableGrid::assume_free_ball` along it): a capsule from the start along its heading.
+///
+/// Why: the planner keeps the whole inflated body in known free space, on a lattice of 2-voxel
+/// cells, and a forward camera sees a tube that wide only from `(inflation + 2 voxels) /
+/// tan(vfov / 2)` ahead; beside and below the UAV it sees nothing. Without this, the first
+/// decision finds the UAV boxed in. The scenario must keep the capsule clear of obstacles
+/// (checked when the run is built), as a take-off area is kept clear.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StartCapsule {
+    pub from: DVec3,
+    pub to: DVec3,
+    pub radius: f64,
+}
+
+impl StartCapsule {
+    pub fn new(start: DVec3, yaw: f64, vfov: f64, inflation: f64, resolution: f64) -> Self {
+        let radius = inflation + 2.0 * resolution;
+        let length = radius / (vfov / 2.0).tan().max(1e-3) + resolution;
+        Self {
+            from: start,
+            to: start + length * DVec3::new(yaw.cos(), yaw.sin(), 0.0),
+            radius,
+        }
+    }
+
+    /// Ball centres along the capsule, a voxel apart.
+    pub fn centres(&self, resolution: f64) -> impl Iterator<Item = DVec3> + '_ {
+        let n = (self.from.distance(self.to) / resolution).ceil().max(1.0) as usize;
+        (0..=n).map(move |i| self.from.lerp(self.to, i as f64 / n as f64))
+    }
+}
+
+/// The planner's inflation radius for an airframe (its radius and the tour's margin).
+pub fn inflation_of(airframe: &Airframe) -> f64 {
+    airframe.bounding_radius() + CLEARANCE_MARGIN_M
+}
+
 /// The components of an exploring `uav[index]`: the true flight hovering at its start, its
 /// `Explorer` settings, its strategy's marker, and a first decision to make.
+#[allow(clippy::too_many_arguments)]
 pub fn explorer_components(
     spec: &UavSpec,
     index: usize,
     airframe: &Airframe,
     physics: &mut Physics,
     explore: &ExploreSpec,
+    geometry: &WorldGeometry,
+    resolution: f64,
 ) -> Result<(impl Bundle + use<>, StrategyMarker), BuildError> {
-    let (_, range) = camera_of(spec).ok_or_else(|| {
+    let camera = first_camera(spec).ok_or_else(|| {
         BuildError::new(
             format!("uav[{index}].sensor"),
             "an exploring UAV needs a depth camera (its field of view and range set the \
              frontier clusters' size and the planning horizon)",
         )
     })?;
+    let range = camera.range_max;
     let start = DVec3::from_array(spec.start.position);
+    let capsule = StartCapsule::new(
+        start,
+        spec.start.yaw,
+        camera.vfov,
+        inflation_of(airframe),
+        resolution,
+    );
+    if capsule
+        .centres(resolution)
+        .any(|c| geometry.intersects_ball(c.as_vec3(), capsule.radius as f32))
+    {
+        return Err(BuildError::new(
+            format!("uav[{index}].start.position"),
+            format!(
+                "an exploring UAV needs clear space around its start: {:.2} m around the \
+                 line from the start {:.2} m ahead along its heading (its body, the planner's \
+                 margin, and what its camera cannot see beside and below it); an obstacle \
+                 lies closer",
+                capsule.radius,
+                capsule.from.distance(capsule.to)
+            ),
+        ));
+    }
     let hover = Hold {
         position: start,
         yaw: spec.start.yaw,
@@ -69,6 +156,8 @@ pub fn explorer_components(
         settings,
         home: start.as_vec3(),
         home_yaw: spec.start.yaw as f32,
+        start_clear: [capsule.from.as_vec3(), capsule.to.as_vec3()],
+        start_clear_radius: capsule.radius,
     };
     let marker = match explore.strategy {
         StrategyName::Eaae => StrategyMarker::Eaae(EaaeStrategy {
@@ -110,10 +199,22 @@ pub fn add_exploration(
     let map = world.resource::<MapConfig>().clone();
     let inflation = airframes
         .iter()
-        .map(|a| a.bounding_radius() + CLEARANCE_MARGIN_M)
+        .map(|a| inflation_of(a))
         .fold(0.0, f64::max);
     insert_frontier_resources(world, ClusterSettings::for_camera(camera.0, camera.1));
-    world.insert_resource(Traversability(TraversableGrid::new(&map, inflation)));
+    let mut grid = TraversableGrid::new(&map, inflation);
+    for explorer in world.query::<&Explorer>().iter(world) {
+        let [from, to] = explorer.start_clear.map(|p| p.as_dvec3());
+        let capsule = StartCapsule {
+            from,
+            to,
+            radius: explorer.start_clear_radius,
+        };
+        for centre in capsule.centres(map.resolution()) {
+            grid.assume_free_ball(centre, capsule.radius);
+        }
+    }
+    world.insert_resource(Traversability(grid));
     insert_exploration_resources(world);
     add_exploration_systems(schedule);
     schedule.add_systems(

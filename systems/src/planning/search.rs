@@ -7,7 +7,8 @@
 //! centres of the cells visited, and the goal.
 //!
 //! End points: a point whose voxel is not traversable (tracking error, a UAV or a viewpoint
-//! close to a wall) is attached to the nearest open cell within [`SNAP_RADIUS_M`]; the path
+//! close to a wall) is attached to the nearest open cell within [`SNAP_RADIUS_M`] (a start) or
+//! [`GOAL_SNAP_RADIUS_M`] (a goal); the path
 //! then starts there with a leg out of the blocked voxel (a start), or ends at that cell's
 //! centre (a goal). A traversable point is attached to the nearest open cell it sees (straight
 //! line over traversable voxels). Determinism: candidates are ordered by distance, then by
@@ -18,8 +19,14 @@ use super::lattice::Lattice;
 use super::traversable::TraversableGrid;
 use glam::{DVec3, IVec3};
 
-/// How far (m) a blocked start or goal may be moved to reach the lattice.
+/// How far (m) a blocked start may be moved to reach the lattice (the trajectory may leave it
+/// through untraversable space for this far, see `super::check`).
 pub const SNAP_RADIUS_M: f64 = 0.5;
+/// How far (m) a blocked goal may be moved to reach the lattice. Goals are frontier centroids
+/// and viewpoints: they sit on the edge of known space, which the inflated body keeps a radius
+/// (and the 2-voxel lattice up to a cell more) away from; any open cell this close still looks
+/// at the frontier.
+pub const GOAL_SNAP_RADIUS_M: f64 = 1.0;
 /// Points closer than this (m) along a path are merged (the trajectory planner refuses
 /// coincident waypoints).
 pub const MIN_POINT_SEPARATION_M: f64 = 0.01;
@@ -35,7 +42,7 @@ struct Endpoint {
     traversable: bool,
 }
 
-fn attach(grid: &TraversableGrid, point: DVec3) -> Option<Endpoint> {
+fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint> {
     let lattice = grid.lattice();
     if !point.is_finite() || !lattice.is_available() {
         return None;
@@ -43,7 +50,7 @@ fn attach(grid: &TraversableGrid, point: DVec3) -> Option<Endpoint> {
     let resolution = grid.resolution();
     let traversable = grid.is_traversable_point(point);
     let home = Lattice::cell_of_key(grid.key_of(point));
-    let n = (SNAP_RADIUS_M / (2.0 * resolution)).ceil() as i32 + 1;
+    let n = (radius / (2.0 * resolution)).ceil() as i32 + 1;
     let mut candidates = Vec::new();
     for dz in -n..=n {
         for dy in -n..=n {
@@ -57,7 +64,7 @@ fn attach(grid: &TraversableGrid, point: DVec3) -> Option<Endpoint> {
                 }
                 let centre = lattice.centre(cell, resolution);
                 let distance = centre.distance(point);
-                if distance <= SNAP_RADIUS_M {
+                if distance <= radius {
                     candidates.push((distance, index, centre));
                 }
             }
@@ -240,8 +247,8 @@ pub fn find_path(
     to: DVec3,
     max_expansions: usize,
 ) -> Option<Vec<DVec3>> {
-    let start = attach(grid, from)?;
-    let goal = attach(grid, to)?;
+    let start = attach(grid, from, SNAP_RADIUS_M)?;
+    let goal = attach(grid, to, GOAL_SNAP_RADIUS_M)?;
     let lattice = grid.lattice();
     let target = lattice.cell(goal.cell);
     let search = explore::<true>(lattice, start.cell, target, max_expansions, |cell| {
@@ -264,10 +271,13 @@ pub fn find_paths(
     max_expansions: usize,
 ) -> Vec<Option<Vec<DVec3>>> {
     let mut result = vec![None; goals.len()];
-    let Some(start) = attach(grid, from) else {
+    let Some(start) = attach(grid, from, SNAP_RADIUS_M) else {
         return result;
     };
-    let ends: Vec<Option<Endpoint>> = goals.iter().map(|&g| attach(grid, g)).collect();
+    let ends: Vec<Option<Endpoint>> = goals
+        .iter()
+        .map(|&g| attach(grid, g, GOAL_SNAP_RADIUS_M))
+        .collect();
     let mut targets: Vec<usize> = ends.iter().flatten().map(|e| e.cell).collect();
     targets.sort_unstable();
     targets.dedup();

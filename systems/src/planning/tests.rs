@@ -97,8 +97,23 @@ fn expected_traversable(map: &TestMap, key: IVec3, radius_voxels: f64) -> bool {
                     continue;
                 }
                 let k = key + d;
+                // Occupied or outside the box blocks; unknown does when an unknown
+                // 6-neighbour (inside the box) backs it.
+                let unknown =
+                    |k: IVec3| map.config.contains_key(k) && map.store.log_odds_milli(k).is_none();
                 let blocked = !map.config.contains_key(k)
-                    || map.store.log_odds_milli(k).is_some_and(|l| l >= 0);
+                    || map.store.log_odds_milli(k).is_some_and(|l| l >= 0)
+                    || (unknown(k)
+                        && [
+                            IVec3::X,
+                            IVec3::NEG_X,
+                            IVec3::Y,
+                            IVec3::NEG_Y,
+                            IVec3::Z,
+                            IVec3::NEG_Z,
+                        ]
+                        .iter()
+                        .any(|&n| unknown(k + n)));
                 if blocked {
                     return false;
                 }
@@ -150,13 +165,24 @@ fn inflation_blocks_exactly_the_ball_and_the_box_border() {
 }
 
 #[test]
-fn unknown_is_not_traversable_but_does_not_block() {
+fn unknown_blocks_like_an_obstacle_unless_it_is_a_lone_hole() {
     let mut map = TestMap::new(DVec3::ZERO, DVec3::splat(1.6));
     map.fill_all(FREE);
+    // A lone unknown voxel (a hole between rays): not traversable itself, blocks nothing.
     map.set(IVec3::splat(8), i16::MIN);
     let grid = map.grid(0.2);
     assert!(!grid.is_traversable(IVec3::splat(8)));
     assert!(grid.is_traversable(IVec3::new(9, 8, 8)));
+    // Two unknown neighbours (an unseen surface): both block within 2 voxels; 3 away (and 3
+    // from the box) is free.
+    map.set(IVec3::new(8, 8, 9), i16::MIN);
+    let grid = map.grid(0.2);
+    assert!(!grid.is_traversable(IVec3::new(10, 8, 8)));
+    assert!(!grid.is_traversable(IVec3::new(9, 9, 8)));
+    assert!(!grid.is_traversable(IVec3::new(8, 8, 11)));
+    assert!(grid.is_traversable(IVec3::new(11, 8, 8)));
+    assert!(grid.is_traversable(IVec3::new(10, 10, 8)));
+    assert!(grid.is_traversable(IVec3::new(8, 8, 12)));
     // A chunk never created holds nothing traversable.
     let empty = TestMap::new(DVec3::ZERO, DVec3::splat(1.6)).grid(0.2);
     assert!(keys(&map.config, 0).all(|k| !empty.is_traversable(k)));
@@ -371,4 +397,27 @@ fn the_ecs_system_marks_changed_chunks_dirty() {
     assert_eq!(world.resource::<Traversability>().0.dirty_chunks(), 0);
     world.remove_resource::<Traversability>();
     schedule.run(&mut world);
+}
+
+#[test]
+fn a_ball_assumed_free_is_traversable_where_it_holds_the_whole_inflation() {
+    // Nothing observed; a ball of 5 voxels assumed free around the centre of voxel 16, with a
+    // 2-voxel inflation: voxel k is traversable when every voxel within 2 of it lies within
+    // 5 of the centre. (3,0,0): farthest (5,0,0), yes; (4,0,0): no; (2,2,0): at most
+    // |(3,3,0)| + ... = 4.47, yes; (3,1,0): (5,1,0) is 5.10 away, no.
+    let map = TestMap::new(DVec3::ZERO, DVec3::splat(3.2));
+    let mut grid = TraversableGrid::new(&map.config, 0.2);
+    let centre = IVec3::splat(16);
+    grid.assume_free_ball((centre.as_dvec3() + 0.5) * 0.1, 0.5);
+    grid.refresh(&map.store);
+    for (offset, expected) in [
+        (IVec3::ZERO, true),
+        (IVec3::new(3, 0, 0), true),
+        (IVec3::new(0, -3, 0), true),
+        (IVec3::new(4, 0, 0), false),
+        (IVec3::new(2, 2, 0), true),
+        (IVec3::new(3, 1, 0), false),
+    ] {
+        assert_eq!(grid.is_traversable(centre + offset), expected, "{offset}");
+    }
 }

@@ -3,14 +3,19 @@
 //!
 //! Rules (decided for this project):
 //! - A voxel is **traversable** when it is known free (common.md §1: observed, l < 0) and no
-//!   known-occupied voxel lies within the inflation radius, measured Euclidean between voxel
-//!   centres (a voxel exactly at the radius counts as within, with a 1e-9 relative tolerance so
-//!   that 0.2 m at 0.1 m is 2 voxels whatever the rounding).
+//!   **blocking** voxel lies within the inflation radius, measured Euclidean between voxel
+//!   centres (a voxel exactly at the radius counts as within, with a 1e-9 relative tolerance
+//!   so that 0.2 m at 0.1 m is 2 voxels whatever the rounding).
+//! - Blocking: known occupied, or unknown with at least one unknown 6-neighbour. The body thus
+//!   stays in known free space (letting unknown voxels come close flew the UAV into a pillar
+//!   face it had never looked at: flying along a face, the camera looks ahead and the face
+//!   beside the path stays unknown), except for lone unknown voxels: the holes a matched ray
+//!   grid leaves between its rays in space it has seen, which would otherwise block all of it.
 //! - Voxels **outside the map box count as occupied** for inflation: the boxes hug the
 //!   enclosure walls, whose surface hits may fall just outside the box. (There is no ceiling in
 //!   the EAAE scenes; staying a radius below the box top is harmless.)
-//! - Unknown voxels are not traversable, but unknown voxels near a traversable one are allowed:
-//!   exploration has to fly along the frontier.
+//! - Goals on the frontier itself are therefore never traversable; the search attaches them to
+//!   the nearest open cell (see `super::search`).
 //!
 //! The grid is kept per map chunk and never recomputed from scratch per query: a changed map
 //! chunk marks itself and the chunks the inflation reaches dirty ([`TraversableGrid::mark_changed`]),
@@ -28,9 +33,9 @@ use crate::mapping::OccupancyMap;
 use glam::{DVec3, IVec3};
 use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, floor_to_key};
 
-/// Largest inflation, in voxels: a chunk plus its halo must fit a 64-bit row (16 + 2 x 24).
-/// Larger radii are clamped (2.4 m at 0.1 m, far beyond any UAV).
-pub const MAX_INFLATION_VOXELS: i32 = 24;
+/// Largest inflation, in voxels: a chunk plus its halo and one voxel more must fit a 64-bit
+/// row (16 + 2 x (23 + 1)). Larger radii are clamped (2.3 m at 0.1 m, far beyond any UAV).
+pub const MAX_INFLATION_VOXELS: i32 = 23;
 const EDGE: i32 = CHUNK_EDGE;
 const ROWS: usize = (CHUNK_EDGE * CHUNK_EDGE) as usize;
 
@@ -58,11 +63,17 @@ pub struct TraversableGrid {
     ball: Vec<BallRow>,
     /// Per chunk, by flat index; `None` when nothing in it is traversable.
     chunks: Vec<Option<Box<ChunkRows>>>,
+    /// Voxels known free without a sensor (see [`TraversableGrid::assume_free_ball`]), per
+    /// chunk as rows; `None` when none.
+    assumed_free: Vec<Option<Box<ChunkRows>>>,
     dirty_flags: Vec<bool>,
     dirty: Vec<usize>,
     lattice: Lattice,
-    /// Halo occupancy rows, and the same dilated along x by 0..=reach.
+    /// Halo blocking rows, and the same dilated along x by 0..=reach.
     occupied: Vec<u64>,
+    /// Occupied and unknown rows over the halo widened by one voxel (see `gather`).
+    gathered_occupied: Vec<u64>,
+    gathered_unknown: Vec<u64>,
     dilated: Vec<u64>,
 }
 
@@ -91,10 +102,13 @@ impl TraversableGrid {
             reach,
             ball,
             chunks: vec![None; n],
+            assumed_free: vec![None; n],
             dirty_flags: vec![false; n],
             dirty: Vec::new(),
             lattice: Lattice::new(config.key_min(), config.key_max()),
             occupied: vec![0; width * width],
+            gathered_occupied: vec![0; (width + 2) * (width + 2)],
+            gathered_unknown: vec![0; (width + 2) * (width + 2)],
             dilated: vec![0; (reach as usize + 1) * width * width],
         }
     }
@@ -121,7 +135,9 @@ impl TraversableGrid {
         if self.chunk_grid.flat(chunk).is_none() {
             return;
         }
-        let span = (self.reach + EDGE - 1) / EDGE;
+        // The inflation reaches `reach` voxels, and whether an unknown voxel blocks depends on
+        // its neighbours one voxel further.
+        let span = (self.reach + 1 + EDGE - 1) / EDGE;
         for dz in -span..=span {
             for dy in -span..=span {
                 for dx in -span..=span {
@@ -131,6 +147,42 @@ impl TraversableGrid {
                     }
                 }
             }
+        }
+    }
+
+    /// Takes the voxels whose centres lie within `radius_m` of `center` as known free, whatever
+    /// the map says, from now on: the space the UAV's body occupies at its start, which the
+    /// scenario checks against the true geometry. (A forward camera never sees beside and
+    /// below itself: without this, the whole-body rule would leave the start untraversable.)
+    pub fn assume_free_ball(&mut self, center: DVec3, radius_m: f64) {
+        if !(center.is_finite() && radius_m.is_finite() && radius_m >= 0.0) {
+            return;
+        }
+        let r = radius_m / self.resolution;
+        let c = center / self.resolution;
+        let lo = floor_to_key(c - DVec3::splat(r)).max(self.key_min);
+        let hi = floor_to_key(c + DVec3::splat(r)).min(self.key_max);
+        let mut touched = Vec::new();
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let key = IVec3::new(x, y, z);
+                    if (key.as_dvec3() + DVec3::splat(0.5)).distance(c) > r {
+                        continue;
+                    }
+                    let coord = ChunkCoord::of_key(key);
+                    let flat = self.chunk_grid.flat_unchecked(coord);
+                    let rows = self.assumed_free[flat].get_or_insert_with(|| Box::new([0; ROWS]));
+                    let l = key & (EDGE - 1);
+                    rows[(l.y + EDGE * l.z) as usize] |= 1 << l.x;
+                    if !touched.contains(&coord) {
+                        touched.push(coord);
+                    }
+                }
+            }
+        }
+        for coord in touched {
+            self.mark_changed(coord);
         }
     }
 
@@ -206,21 +258,24 @@ impl TraversableGrid {
     fn refresh_chunk(&mut self, map: &impl OccupancyMap, flat: usize) {
         let coord = self.chunk_grid.coord(flat);
         let first = coord.first_key();
-        let rows = match map.chunk(coord) {
-            Some(chunk) => {
-                let free = self.free_rows(chunk, first);
-                if free.iter().any(|&r| r != 0) {
-                    let blocked = self.blocked_rows(map, first);
-                    let mut rows = free;
-                    rows.iter_mut()
-                        .zip(blocked.iter())
-                        .for_each(|(r, b)| *r &= !b);
-                    rows.iter().any(|&r| r != 0).then_some(rows)
-                } else {
-                    None
-                }
-            }
-            None => None,
+        let mut free = match map.chunk(coord) {
+            Some(chunk) => self.free_rows(chunk, first),
+            None => [0; ROWS],
+        };
+        if let Some(assumed) = &self.assumed_free[flat] {
+            free.iter_mut()
+                .zip(assumed.iter())
+                .for_each(|(f, a)| *f |= a);
+        }
+        let rows = if free.iter().any(|&r| r != 0) {
+            let blocked = self.blocked_rows(map, first);
+            let mut rows = free;
+            rows.iter_mut()
+                .zip(blocked.iter())
+                .for_each(|(r, b)| *r &= !b);
+            rows.iter().any(|&r| r != 0).then_some(rows)
+        } else {
+            None
         };
         self.update_lattice(first, rows.as_ref());
         match (&mut self.chunks[flat], rows) {
@@ -263,69 +318,32 @@ impl TraversableGrid {
         rows
     }
 
-    /// Voxels of the chunk with a known-occupied (or out-of-box) voxel within the radius.
+    /// Voxels of the chunk with a blocking voxel (see the module doc) within the radius.
     fn blocked_rows(&mut self, map: &impl OccupancyMap, first: IVec3) -> ChunkRows {
         let r = self.reach;
         let width = EDGE + 2 * r;
         let w = width as usize;
-        let halo_min = first - IVec3::splat(r);
-        let halo_max = first + IVec3::splat(EDGE - 1 + r);
-        let all = if width == 64 {
+        self.gather(map, first);
+        // Blocking voxels of the inflation halo: occupied, or unknown with an unknown
+        // 6-neighbour (the gathered grid is one voxel wider on every side for these).
+        let gw = w + 2;
+        let mask = if width == 64 {
             u64::MAX
         } else {
             (1u64 << width) - 1
         };
-        // Out-of-box voxels are occupied.
-        let mut outside_x = 0u64;
-        for hx in 0..width {
-            let x = halo_min.x + hx;
-            if !(self.key_min.x..=self.key_max.x).contains(&x) {
-                outside_x |= 1 << hx;
-            }
-        }
-        for hz in 0..width {
-            for hy in 0..width {
-                let key = halo_min + IVec3::new(0, hy, hz);
-                let in_yz = (self.key_min.y..=self.key_max.y).contains(&key.y)
-                    && (self.key_min.z..=self.key_max.z).contains(&key.z);
-                self.occupied[hy as usize + w * hz as usize] = if in_yz { outside_x } else { all };
-            }
-        }
-        // Known-occupied voxels (l >= 0) of every chunk the halo overlaps.
-        let (c_lo, c_hi) = (
-            ChunkCoord::of_key(halo_min).0,
-            ChunkCoord::of_key(halo_max).0,
-        );
-        for cz in c_lo.z..=c_hi.z {
-            for cy in c_lo.y..=c_hi.y {
-                for cx in c_lo.x..=c_hi.x {
-                    let coord = ChunkCoord(IVec3::new(cx, cy, cz));
-                    let Some(chunk) = map.chunk(coord) else {
-                        continue;
-                    };
-                    let voxels = chunk.voxels();
-                    let c_first = coord.first_key();
-                    let lo = halo_min.max(c_first).max(self.key_min);
-                    let hi = halo_max
-                        .min(c_first + IVec3::splat(EDGE - 1))
-                        .min(self.key_max);
-                    if lo.cmpgt(hi).any() {
-                        continue;
-                    }
-                    for z in lo.z..=hi.z {
-                        for y in lo.y..=hi.y {
-                            let local = ((y - c_first.y) + EDGE * (z - c_first.z)) * EDGE;
-                            let row = &mut self.occupied
-                                [(y - halo_min.y) as usize + w * (z - halo_min.z) as usize];
-                            let mut bits = 0u64;
-                            for x in lo.x..=hi.x {
-                                let l = voxels[(local + x - c_first.x) as usize].log_odds;
-                                bits |= u64::from(l >= 0) << (x - halo_min.x);
-                            }
-                            *row |= bits;
-                        }
-                    }
-                }
+        for z in 1..=w {
+            for y in 1..=w {
+                let i = y + gw * z;
+                let u = self.gathered_unknown[i];
+                let neighbours = u << 1
+                    | u >> 1
+                    | self.gathered_unknown[i - 1]
+                    | self.gathered_unknown[i + 1]
+                    | self.gathered_unknown[i - gw]
+                    | self.gathered_unknown[i + gw];
+                let blocking = self.gathered_occupied[i] | (u & neighbours);
+                self.occupied[(y - 1) + w * (z - 1)] = (blocking >> 1) & mask;
             }
         }
         // Dilation along x by each half-width 0..=r.
@@ -349,6 +367,93 @@ impl TraversableGrid {
             }
         }
         blocked
+    }
+
+    /// Gathers, over the chunk and a halo of `reach + 1` voxels, the occupied voxels (known
+    /// occupied, or outside the box) and the unknown ones (in the box, never observed, not
+    /// assumed free) as bit rows along x.
+    fn gather(&mut self, map: &impl OccupancyMap, first: IVec3) {
+        let g = self.reach + 1;
+        let width = EDGE + 2 * g;
+        let gw = width as usize;
+        let halo_min = first - IVec3::splat(g);
+        let halo_max = first + IVec3::splat(EDGE - 1 + g);
+        let all = if width == 64 {
+            u64::MAX
+        } else {
+            (1u64 << width) - 1
+        };
+        let mut outside_x = 0u64;
+        for hx in 0..width {
+            if !(self.key_min.x..=self.key_max.x).contains(&(halo_min.x + hx)) {
+                outside_x |= 1 << hx;
+            }
+        }
+        for hz in 0..width {
+            for hy in 0..width {
+                let (y, z) = (halo_min.y + hy, halo_min.z + hz);
+                let in_yz = (self.key_min.y..=self.key_max.y).contains(&y)
+                    && (self.key_min.z..=self.key_max.z).contains(&z);
+                let i = hy as usize + gw * hz as usize;
+                // Out of the box: occupied. In it: unknown until observed.
+                self.gathered_occupied[i] = if in_yz { outside_x } else { all };
+                self.gathered_unknown[i] = if in_yz { all & !outside_x } else { 0 };
+            }
+        }
+        let (c_lo, c_hi) = (
+            ChunkCoord::of_key(halo_min).0,
+            ChunkCoord::of_key(halo_max).0,
+        );
+        for cz in c_lo.z..=c_hi.z {
+            for cy in c_lo.y..=c_hi.y {
+                for cx in c_lo.x..=c_hi.x {
+                    let coord = ChunkCoord(IVec3::new(cx, cy, cz));
+                    let chunk = map.chunk(coord);
+                    let assumed = self
+                        .chunk_grid
+                        .flat(coord)
+                        .and_then(|flat| self.assumed_free[flat].as_deref());
+                    if chunk.is_none() && assumed.is_none() {
+                        continue;
+                    }
+                    let c_first = coord.first_key();
+                    let lo = halo_min.max(c_first).max(self.key_min);
+                    let hi = halo_max
+                        .min(c_first + IVec3::splat(EDGE - 1))
+                        .min(self.key_max);
+                    if lo.cmpgt(hi).any() {
+                        continue;
+                    }
+                    for z in lo.z..=hi.z {
+                        for y in lo.y..=hi.y {
+                            let local_row = ((y - c_first.y) + EDGE * (z - c_first.z)) as usize;
+                            let i = (y - halo_min.y) as usize + gw * (z - halo_min.z) as usize;
+                            let assumed_row = assumed.map_or(0, |a| a[local_row]);
+                            let (mut known, mut occupied) = (0u64, 0u64);
+                            for x in lo.x..=hi.x {
+                                let lx = x - c_first.x;
+                                let bit = 1u64 << (x - halo_min.x);
+                                if assumed_row >> lx & 1 == 1 {
+                                    known |= bit;
+                                    continue;
+                                }
+                                let Some(chunk) = chunk else { continue };
+                                let l = chunk.voxels()[local_row * EDGE as usize + lx as usize]
+                                    .log_odds;
+                                if l != i16::MIN {
+                                    known |= bit;
+                                    if l >= 0 {
+                                        occupied |= bit;
+                                    }
+                                }
+                            }
+                            self.gathered_unknown[i] &= !known;
+                            self.gathered_occupied[i] |= occupied;
+                        }
+                    }
+                }
+            }
+        }
     }
 
     /// Writes the chunk's cells into the lattice (a cell is open when all 8 voxels are).

@@ -208,6 +208,9 @@ pub struct FlownLeg {
     pub time_s: f64,
     /// (flown - predicted) / predicted energy; meaningful when `outcome` is `Reached`.
     pub prediction_error: f64,
+    /// Whether the evaluated candidate itself was flown to the end (unified mode, never
+    /// replaced by the local planner).
+    pub flew_candidate: bool,
 }
 
 /// One decision: every candidate, the choice, and afterwards the flown leg. Deterministic: a

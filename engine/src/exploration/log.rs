@@ -64,7 +64,7 @@ pub fn decisions_csv(log: &DecisionLog) -> String {
         "decision,uav,time_s,x,y,z,clusters,candidate,centroid_x,centroid_y,centroid_z,goal_x,\
          goal_y,goal_z,information_gain,centroid_distance_m,path_length_m,predicted_energy_j,\
          predicted_duration_s,unaffordable,chosen,goal_kind,outcome,flown_energy_j,flown_time_s,\
-         prediction_error\n",
+         prediction_error,flew_candidate\n",
     );
     for (index, d) in log.decisions.iter().enumerate() {
         let head = format!(
@@ -74,13 +74,14 @@ pub fn decisions_csv(log: &DecisionLog) -> String {
         let kind = d.goal_kind.as_ref().map(json).unwrap_or_default();
         let flown = |chosen: bool| match (&d.flown, chosen) {
             (Some(f), true) => format!(
-                "{},{},{},{}",
+                "{},{},{},{},{}",
                 json(&f.outcome),
                 f.energy_j,
                 f.time_s,
-                f.prediction_error
+                f.prediction_error,
+                f.flew_candidate
             ),
-            _ => ",,,".to_owned(),
+            _ => ",,,,".to_owned(),
         };
         if d.candidates.is_empty() {
             let _ = writeln!(out, "{head},,,,,,,,,,,,,,,{kind},{}", flown(true));
@@ -171,6 +172,7 @@ mod tests {
                         energy_j: 440.0,
                         time_s: 4.5,
                         prediction_error: 0.1,
+                        flew_candidate: false,
                     }),
                 },
                 DecisionRecord {
@@ -186,6 +188,7 @@ mod tests {
                         energy_j: 270.0,
                         time_s: 3.0,
                         prediction_error: -0.1,
+                        flew_candidate: false,
                     }),
                 },
                 DecisionRecord {
@@ -221,7 +224,7 @@ mod tests {
         assert_eq!(lines.len(), 1 + 2 + 1 + 1);
         assert_eq!(
             lines[2],
-            "0,0,0,0,0,1,2,1,1,2,1,1,2,1,50,2.5,3,400,4,false,true,frontier,reached,440,4.5,0.1"
+            "0,0,0,0,0,1,2,1,1,2,1,1,2,1,50,2.5,3,400,4,false,true,frontier,reached,440,4.5,0.1,false"
         );
         assert!(
             lines[1].ends_with(",false,false,frontier,,,,"),

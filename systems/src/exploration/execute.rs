@@ -42,18 +42,24 @@ pub enum GoalStatus {
     Ended(GoalOutcome),
 }
 
-/// The goal rules of eaae.md step 10 (plain function): reached when within the distance and
-/// speed tolerances; invalid when fewer than `vanished_fraction` of its voxels are still
+/// The goal rules of eaae.md step 10 (plain function): reached when the reference has run to
+/// its end and the UAV is within the distance and speed tolerances there (the rule the
+/// rollout's `Completion` applies, so flown and predicted legs end alike); invalid when fewer than `vanished_fraction` of its voxels are still
 /// frontier; hopeless after `no_progress_timeout_s` without getting closer.
+#[allow(clippy::too_many_arguments)]
 pub fn goal_status(
     goal: &ExplorationGoal,
     settings: &ExplorerSettings,
+    reference_ended: bool,
     distance_m: f64,
     speed: f64,
     still_frontier: usize,
     time_s: f64,
 ) -> GoalStatus {
-    if distance_m <= settings.goal_tolerance_m && speed <= settings.goal_speed_tolerance {
+    if reference_ended
+        && distance_m <= settings.goal_tolerance_m
+        && speed <= settings.goal_speed_tolerance
+    {
         return GoalStatus::Ended(GoalOutcome::Reached);
     }
     if goal.kind == GoalKind::Frontier
@@ -145,9 +151,16 @@ pub fn fly_to_goals(
             goal.members.len()
         };
         let speed = f64::from(state.velocity.length());
-        if let GoalStatus::Ended(outcome) =
-            goal_status(&goal, settings, distance, speed, still_frontier, time_s)
-        {
+        let reference_ended = reference.elapsed(time_s) >= reference.trajectory.duration() - 1e-9;
+        if let GoalStatus::Ended(outcome) = goal_status(
+            &goal,
+            settings,
+            reference_ended,
+            distance,
+            speed,
+            still_frontier,
+            time_s,
+        ) {
             let flown_energy = energy_drawn(energy) - goal.energy_at_start_j;
             if let Some(record) = log.decisions.get_mut(goal.decision) {
                 let predicted = record
@@ -161,6 +174,7 @@ pub fn fly_to_goals(
                     prediction_error: predicted
                         .filter(|p| *p > 0.0)
                         .map_or(f64::NAN, |p| (flown_energy - p) / p),
+                    flew_candidate: goal.flying_candidate,
                 });
             }
             let mut entity = commands.entity(uav);
@@ -254,31 +268,36 @@ mod tests {
         let g = goal(100);
         // Far, fast, all frontier left, recent progress: flying.
         assert_eq!(
-            goal_status(&g, &settings, 3.0, 2.0, 100, 12.0),
+            goal_status(&g, &settings, true, 3.0, 2.0, 100, 12.0),
             GoalStatus::Flying
         );
         // Within 0.3 m and slower than 0.5 m/s: reached (even if the frontier is gone).
         assert_eq!(
-            goal_status(&g, &settings, 0.29, 0.4, 0, 12.0),
+            goal_status(&g, &settings, true, 0.29, 0.4, 0, 12.0),
             GoalStatus::Ended(GoalOutcome::Reached)
+        );
+        // Close and slow, but the reference still runs: not yet.
+        assert_eq!(
+            goal_status(&g, &settings, false, 0.29, 0.4, 100, 12.0),
+            GoalStatus::Flying
         );
         // Close but still fast: not reached.
         assert_eq!(
-            goal_status(&g, &settings, 0.29, 0.6, 100, 12.0),
+            goal_status(&g, &settings, true, 0.29, 0.6, 100, 12.0),
             GoalStatus::Flying
         );
         // 19 of 100 voxels left < 20 %: invalidated; 20 left is still valid.
         assert_eq!(
-            goal_status(&g, &settings, 3.0, 2.0, 19, 12.0),
+            goal_status(&g, &settings, true, 3.0, 2.0, 19, 12.0),
             GoalStatus::Ended(GoalOutcome::Invalidated)
         );
         assert_eq!(
-            goal_status(&g, &settings, 3.0, 2.0, 20, 12.0),
+            goal_status(&g, &settings, true, 3.0, 2.0, 20, 12.0),
             GoalStatus::Flying
         );
         // No progress since t = 10 s: hopeless after 6 s.
         assert_eq!(
-            goal_status(&g, &settings, 3.0, 2.0, 100, 16.01),
+            goal_status(&g, &settings, true, 3.0, 2.0, 100, 16.01),
             GoalStatus::Ended(GoalOutcome::NoProgress)
         );
         // A home goal has no frontier to vanish.
@@ -287,7 +306,7 @@ mod tests {
             ..goal(0)
         };
         assert_eq!(
-            goal_status(&home, &settings, 3.0, 2.0, 0, 12.0),
+            goal_status(&home, &settings, true, 3.0, 2.0, 0, 12.0),
             GoalStatus::Flying
         );
     }

@@ -167,8 +167,10 @@ pub struct ExplorationGoal {
     /// Closest distance to the goal so far and when it was reached (no-progress rule).
     pub best_distance_m: f64,
     pub best_distance_s: f64,
-    /// Last replanning time of the local planner (s).
+    /// Last replanning time of the local planner, and last check of the flown trajectory
+    /// against the map (s).
     pub last_plan_s: f64,
+    pub last_check_s: f64,
     /// Flying the evaluated candidate itself (unified mode) rather than the local planner's.
     pub flying_candidate: bool,
 }

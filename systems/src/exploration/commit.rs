@@ -170,6 +170,7 @@ pub fn commit_decisions(
                     } else {
                         f64::NEG_INFINITY
                     },
+                    last_check_s: time_s,
                     flying_candidate: settings.unified,
                 });
             }

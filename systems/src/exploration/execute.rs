@@ -2,8 +2,9 @@
 //! goal ends when reached, when its frontier vanished, or after no progress for a set time;
 //! each ending triggers the next decision.
 //!
-//! Local planner: every `replan_period_s`, and at once when the map makes the rest of the
-//! current trajectory non-traversable, a new trajectory is planned from the current reference
+//! Local planner: every `replan_period_s`, and as soon as the map makes the rest of the
+//! current trajectory non-traversable (checked every [`COLLISION_CHECK_PERIOD_S`]), a new
+//! trajectory is planned from the current reference
 //! state toward the goal over at most `horizon_m` of path (1.5 x the sensor range), on the
 //! latest map ([`plan_local`]). In unified mode the evaluated candidate itself is flown while
 //! it stays traversable; once it does not, the local planner takes over.
@@ -30,6 +31,11 @@ use uavex_components::frontier::FrontierSet;
 use uavex_components::sim::SimClock;
 use uavex_components::trajectory::Hold;
 use uavex_components::uav::{QuadState, Uav, UavEnded};
+
+/// How often the rest of the flown trajectory is checked against the latest map (s): a
+/// trajectory the map makes collide is replanned at once, between the regular replans. (Every
+/// map update would be 30 Hz; the inflation's refresh then costs as much as the mapping.)
+pub const COLLISION_CHECK_PERIOD_S: f64 = 0.1;
 
 /// Frontier voxels that were still frontier after a goal covering them was reached.
 #[derive(Resource, Debug, Default, Clone, PartialEq)]
@@ -204,7 +210,8 @@ pub fn fly_to_goals(
             continue;
         }
 
-        if !due {
+        let check_due = time_s - goal.last_check_s >= COLLISION_CHECK_PERIOD_S;
+        if !due && !check_due {
             continue;
         }
         grid.0.refresh(&map);
@@ -216,6 +223,10 @@ pub fn fly_to_goals(
             elapsed.max(0.0),
             limits.max_velocity,
         );
+        goal.last_check_s = time_s;
+        if !due && !blocked {
+            continue;
+        }
         goal.last_plan_s = time_s;
         if goal.flying_candidate && !blocked {
             continue;
@@ -258,6 +269,7 @@ mod tests {
             best_distance_m: 5.0,
             best_distance_s: 10.0,
             last_plan_s: 10.0,
+            last_check_s: 10.0,
             flying_candidate: false,
         }
     }

@@ -14,13 +14,13 @@
 
 use std::time::Instant;
 use uavex_components::exploration::{DecisionLog, DecisionTiming, DecisionTimings};
+use uavex_engine::exploration::log::percentile;
 use uavex_engine::exploration::{AllCandidates, CandidateCount};
 use uavex_engine::scenario::{BehaviourSpec, load};
 use uavex_engine::sim::Sim;
 
 fn quantile(sorted: &[f64], q: f64) -> f64 {
-    let rank = (q * sorted.len() as f64).ceil().max(1.0) as usize;
-    sorted[rank.min(sorted.len()) - 1]
+    percentile(sorted, q).unwrap_or(f64::NAN)
 }
 
 fn main() {

@@ -131,19 +131,30 @@ pub fn planning_start(
     )
 }
 
-/// The targets of one UAV's decision: reachable clusters at least `min_distance` away, in a
-/// deterministic order (by centroid, then size). `all_distances` lifts the too-close filter.
-pub fn targets_for(
+/// Eaae.md steps 3 (the too-close rule) and 6 for one UAV at `position`: the targets at least
+/// `min_distance` away (in the order given: the caller sorts them deterministically) and their
+/// planned candidates; when none of those is feasible, the too-close targets instead (rather
+/// than ending with frontier in reach). Returns the targets planned and the candidates, whose
+/// `target` indexes them.
+pub fn plan_decision(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
     clusters: &[ClusterTarget],
     position: Vec3,
     min_distance: f32,
-    all_distances: bool,
-) -> Vec<ClusterTarget> {
-    clusters
+    limits: &DynamicLimits,
+    min_travel_m: f64,
+) -> (Vec<ClusterTarget>, Vec<PlannedCandidate>) {
+    let (far, near): (Vec<ClusterTarget>, Vec<ClusterTarget>) = clusters
         .iter()
-        .filter(|c| all_distances || c.centroid.distance(position) >= min_distance)
         .cloned()
-        .collect()
+        .partition(|c| c.centroid.distance(position) >= min_distance);
+    let planned = plan_candidates(grid, start, &far, limits, min_travel_m);
+    if !planned.is_empty() || near.is_empty() {
+        return (far, planned);
+    }
+    let planned = plan_candidates(grid, start, &near, limits, min_travel_m);
+    (near, planned)
 }
 
 /// Candidates of this decision, for the commit (how many clusters it saw, its timings, the
@@ -214,14 +225,15 @@ pub fn propose_candidates(
         let min_travel = settings.goal_tolerance_m;
 
         let planning = Instant::now();
-        let mut targets = targets_for(&all, state.position, settings.min_goal_distance_m, false);
-        let mut planned = plan_candidates(&grid.0, &start, &targets, &limits, min_travel);
-        if planned.is_empty() {
-            // Only too-close clusters are left (or none is feasible from afar): rather than
-            // ending with frontier in reach, consider them too.
-            targets = targets_for(&all, state.position, 0.0, true);
-            planned = plan_candidates(&grid.0, &start, &targets, &limits, min_travel);
-        }
+        let (targets, planned) = plan_decision(
+            &grid.0,
+            &start,
+            &all,
+            state.position,
+            settings.min_goal_distance_m,
+            &limits,
+            min_travel,
+        );
         let trajectory_ms = planning.elapsed().as_secs_f64() * 1e3;
 
         let estimating = Instant::now();

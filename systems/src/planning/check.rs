@@ -16,7 +16,7 @@ use super::search::SNAP_RADIUS_M;
 use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
 use glam::DVec3;
-use uavex_components::trajectory::Trajectory;
+use uavex_components::trajectory::{PiecewisePolynomial, Trajectory};
 
 /// The first sample from `t0` on that breaks the traversability (with the escape rule of the
 /// module doc), as (time, position); `None` when there is none. Non-positive or non-finite
@@ -27,19 +27,77 @@ pub fn first_untraversable(
     t0: f64,
     max_speed: f64,
 ) -> Option<(f64, DVec3)> {
-    let end = trajectory.duration();
+    scan(
+        grid,
+        trajectory.duration(),
+        |t| trajectory.sample(t).position,
+        t0,
+        max_speed,
+    )
+}
+
+/// [`first_untraversable`] for a piecewise polynomial, evaluating positions only (the full
+/// sample also forms four derivatives of four outputs, five times the work, at every 5 cm).
+/// Same samples, same positions bit for bit, same answer.
+pub fn first_untraversable_polynomial(
+    grid: &TraversableGrid,
+    trajectory: &PiecewisePolynomial,
+    t0: f64,
+    max_speed: f64,
+) -> Option<(f64, DVec3)> {
+    scan(
+        grid,
+        trajectory.duration(),
+        |t| polynomial_position(trajectory, t),
+        t0,
+        max_speed,
+    )
+}
+
+/// `trajectory.sample(t).position`, computed as `PolynomialSegment::derivatives` computes its
+/// order 0 (Horner from the highest coefficient, times a scale of exactly 1).
+pub fn polynomial_position(trajectory: &PiecewisePolynomial, t: f64) -> DVec3 {
+    let segments = trajectory.segments();
+    let (segment, tau) = if t >= trajectory.duration() {
+        (&segments[segments.len() - 1], 1.0)
+    } else {
+        let (index, tau) = trajectory.locate(t);
+        (&segments[index], tau)
+    };
+    let axis = |c: &[f64; 8]| {
+        let mut acc = 0.0;
+        for k in (0..c.len()).rev() {
+            acc = acc * tau + c[k];
+        }
+        acc
+    };
+    DVec3::new(
+        axis(&segment.coefficients[0]),
+        axis(&segment.coefficients[1]),
+        axis(&segment.coefficients[2]),
+    )
+}
+
+/// The sampling loop of [`first_untraversable`] over any position function of time.
+fn scan(
+    grid: &TraversableGrid,
+    end: f64,
+    position: impl Fn(f64) -> DVec3,
+    t0: f64,
+    max_speed: f64,
+) -> Option<(f64, DVec3)> {
     let valid = max_speed.is_finite() && max_speed > 0.0 && t0.is_finite() && end.is_finite();
     if !valid {
-        return Some((t0, trajectory.sample(0.0).position));
+        return Some((t0, position(0.0)));
     }
     let step = COLLISION_SAMPLE_SPACING_M / max_speed;
     let t0 = t0.clamp(0.0, end);
     let samples = ((end - t0) / step).ceil() as u64;
-    let origin = trajectory.sample(t0).position;
+    let origin = position(t0);
     let mut escaping = !grid.is_traversable_point(origin);
     for i in 0..=samples {
         let t = (t0 + i as f64 * step).min(end);
-        let p = trajectory.sample(t).position;
+        let p = position(t);
         if grid.is_traversable_point(p) {
             escaping = false;
         } else if !escaping || p.distance(origin) > SNAP_RADIUS_M {

@@ -27,7 +27,9 @@ mod tests;
 #[cfg(test)]
 mod tests_planner;
 
-pub use check::{first_untraversable, remains_traversable};
+pub use check::{
+    first_untraversable, first_untraversable_polynomial, polynomial_position, remains_traversable,
+};
 pub use global::{GlobalPlan, plan_along, plan_global};
 pub use local::{LocalPlan, plan_local};
 pub use search::{SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};

@@ -176,6 +176,50 @@ fn a_start_inside_the_inflation_escapes() {
 }
 
 /// Random box obstacles (pillars and floating blocks) in a 6.4 x 6.4 x 2.4 m room.
+#[test]
+fn the_polynomial_check_samples_the_same_positions_as_the_generic_one() {
+    // Around the wall (several segments) and out of the inflation (the escape rule).
+    let mut map = wall_room();
+    let mut grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(2.85, 1.0, 0.8), 0.0);
+    let plan = plan_global(&grid, &start, DVec3::new(1.0, 2.0, 0.8), None, &limits).unwrap();
+    let trajectory = &plan.trajectory;
+    let end = trajectory.duration();
+    for i in 0..=1000 {
+        // Past the end too: the end position, held.
+        let t = end * 1.1 * f64::from(i) / 1000.0;
+        let (fast, full) = (
+            polynomial_position(trajectory, t),
+            trajectory.sample(t).position,
+        );
+        assert_eq!(
+            fast.to_array().map(f64::to_bits),
+            full.to_array().map(f64::to_bits),
+            "{t}"
+        );
+    }
+    for t0 in [0.0, 0.3 * end, end] {
+        assert_eq!(
+            first_untraversable_polynomial(&grid, trajectory, t0, 5.0),
+            first_untraversable(&grid, trajectory, t0, 5.0)
+        );
+    }
+    // A block on the way: both report the same first sample.
+    map.fill(IVec3::new(5, 8, 0), IVec3::new(25, 30, 23), OCCUPIED);
+    map.update(&mut grid);
+    let blocked = first_untraversable(&grid, trajectory, 0.0, 5.0);
+    assert!(blocked.is_some());
+    assert_eq!(
+        first_untraversable_polynomial(&grid, trajectory, 0.0, 5.0),
+        blocked
+    );
+    assert_eq!(
+        first_untraversable_polynomial(&grid, trajectory, 0.0, f64::NAN),
+        first_untraversable(&grid, trajectory, 0.0, f64::NAN)
+    );
+}
+
 fn random_map(boxes: &[(i32, i32, i32, i32, i32, i32)]) -> TestMap {
     let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 2.4));
     map.fill_all(FREE);

@@ -1,0 +1,294 @@
+//! One exploration decision, focused (issue 4: decision p95 <= 20 ms on ONE core).
+//!
+//! `benches/exploration.rs` times decisions inside whole missions (1-2 min per seed). This bench
+//! flies the shipped EAAE Pillars mission once per seed with a snapshot system placed just
+//! before the candidates are proposed (`DecideStep::Propose`): at every decision it keeps the
+//! refreshed traversability grid, the planning start, the cluster targets, the frontier points
+//! and the rollout inputs, and times the clustering in place (`cluster_frontier` on the live
+//! map, as `refresh_clusters` runs it). The decisions are then replayed on a one-thread rayon
+//! pool, each `REPEATS` times (the fastest kept, the machine is shared):
+//!
+//! - trajectories: `plan_candidates` with the propose step's fallback to too-close clusters;
+//! - energy: `roll_out_candidates` on those candidates;
+//! - 2-means: `divisive_two_means` alone on the frontier points.
+//!
+//! It prints p50 / p95 / max per part and of the sum (clustering + trajectories + energy), and
+//! a digest of every planned candidate (target, viewpoint, trajectory bits), so that a change
+//! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
+//! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
+//! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_LOOPS=n` replays the planning
+//! n more times (for `perf record`).
+//!
+//! `cargo bench --bench decision` (a plain timed program, `harness = false`).
+
+use bevy_ecs::prelude::*;
+use glam::Vec3;
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+use std::io::Write;
+use std::time::Instant;
+use uavex_components::airframe::Airframe;
+use uavex_components::exploration::{Explorer, NeedsDecision};
+use uavex_components::frontier::{
+    ClusterSettings, FrontierCluster, FrontierSet, Reachable, Viewpoints,
+};
+use uavex_components::sim::{RunSeed, SimClock, stream};
+use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
+use uavex_components::uav::QuadState;
+use uavex_engine::exploration::log::percentile;
+use uavex_engine::scenario::load;
+use uavex_engine::sim::Sim;
+use uavex_systems::exploration::DecideStep;
+use uavex_systems::exploration::propose::{
+    ClusterTarget, PlannedCandidate, plan_decision, planning_start, propose_candidates,
+    roll_out_candidates,
+};
+use uavex_systems::flight::ecs::ReferenceTrajectory;
+use uavex_systems::flight::{Completion, FlightState, RolloutConfig};
+use uavex_systems::frontier::{cluster_frontier, divisive_two_means};
+use uavex_systems::mapping::MapReader;
+use uavex_systems::planning::{Traversability, TraversableGrid};
+use uavex_systems::trajectory::DynamicLimits;
+
+const REPEATS: usize = 3;
+
+/// Everything one decision's planning needs, as the propose step sees it.
+struct Snapshot {
+    grid: TraversableGrid,
+    start: TrajectoryPoint,
+    flight: FlightState,
+    airframe: Airframe,
+    limits: DynamicLimits,
+    config: RolloutConfig,
+    position: Vec3,
+    min_goal_distance_m: f32,
+    min_travel_m: f64,
+    clusters: Vec<ClusterTarget>,
+    points: Vec<Vec3>,
+    r_max_m: f32,
+    clustering_ms: f64,
+}
+
+#[derive(Resource, Default)]
+struct Snapshots(Vec<Snapshot>);
+
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+fn snapshot(
+    clock: Res<SimClock>,
+    map: MapReader,
+    mut grid: ResMut<Traversability>,
+    set: Res<FrontierSet>,
+    settings: Res<ClusterSettings>,
+    seed: Res<RunSeed>,
+    uavs: Query<
+        (
+            &Explorer,
+            &Airframe,
+            &QuadState,
+            Option<&ReferenceTrajectory>,
+        ),
+        With<NeedsDecision>,
+    >,
+    clusters: Query<(Entity, &FrontierCluster, &Viewpoints), With<Reachable>>,
+    mut snapshots: ResMut<Snapshots>,
+) {
+    if uavs.is_empty() {
+        return;
+    }
+    grid.0.refresh(&map);
+    // The clustering of this decision, timed on the live map (any stream: the cost is alike).
+    let mut rng = seed.stream(stream::CLUSTERING, snapshots.0.len() as u64);
+    let clustering = Instant::now();
+    let found = cluster_frontier(&set, &map, &settings, &mut rng);
+    let clustering_ms = clustering.elapsed().as_secs_f64() * 1e3;
+    std::hint::black_box(found);
+    let config = map.config.clone();
+    let points: Vec<Vec3> = set.iter().map(|k| config.center_of(k)).collect();
+    let mut all: Vec<ClusterTarget> = clusters
+        .iter()
+        .map(|(entity, cluster, viewpoints)| ClusterTarget {
+            entity,
+            centroid: cluster.centroid,
+            size: cluster.size,
+            viewpoints: viewpoints.0.clone(),
+        })
+        .collect();
+    // As `propose_candidates` orders them.
+    all.sort_by(|a, b| {
+        a.centroid
+            .to_array()
+            .map(f32::to_bits)
+            .cmp(&b.centroid.to_array().map(f32::to_bits))
+            .then(a.size.cmp(&b.size))
+    });
+    for (explorer, airframe, state, reference) in &uavs {
+        let s = &explorer.settings;
+        snapshots.0.push(Snapshot {
+            grid: grid.0.clone(),
+            start: planning_start(reference, state, clock.time_s()),
+            flight: FlightState::from(state),
+            airframe: airframe.clone(),
+            limits: DynamicLimits::of(airframe),
+            config: RolloutConfig {
+                completion: Completion {
+                    position_tolerance: s.goal_tolerance_m,
+                    speed_tolerance: s.goal_speed_tolerance,
+                    ..Completion::default()
+                },
+                ..RolloutConfig::default()
+            },
+            position: state.position,
+            min_goal_distance_m: s.min_goal_distance_m,
+            min_travel_m: s.goal_tolerance_m,
+            clusters: all.clone(),
+            points: points.clone(),
+            r_max_m: settings.r_max_m,
+            clustering_ms,
+        });
+    }
+}
+
+/// The propose step's planning ([`plan_decision`]).
+fn plan(s: &Snapshot) -> Vec<PlannedCandidate> {
+    plan_decision(
+        &s.grid,
+        &s.start,
+        &s.clusters,
+        s.position,
+        s.min_goal_distance_m,
+        &s.limits,
+        s.min_travel_m,
+    )
+    .1
+}
+
+fn digest(planned: &[PlannedCandidate]) -> u64 {
+    let mut h = DefaultHasher::new();
+    for c in planned {
+        c.target.hash(&mut h);
+        c.viewpoint.hash(&mut h);
+        c.goal.to_array().map(f64::to_bits).hash(&mut h);
+        c.plan.path_length_m.to_bits().hash(&mut h);
+        c.plan.trajectory.duration().to_bits().hash(&mut h);
+        for segment in c.plan.trajectory.segments() {
+            segment.duration.to_bits().hash(&mut h);
+            for output in &segment.coefficients {
+                output.map(f64::to_bits).hash(&mut h);
+            }
+        }
+    }
+    h.finish()
+}
+
+fn fastest_ms<T>(mut f: impl FnMut() -> T) -> (f64, T) {
+    let mut best = f64::INFINITY;
+    let mut out = None;
+    for _ in 0..REPEATS {
+        let started = Instant::now();
+        let value = f();
+        best = best.min(started.elapsed().as_secs_f64() * 1e3);
+        out = Some(value);
+    }
+    (best, out.expect("REPEATS > 0"))
+}
+
+fn quantiles(mut v: Vec<f64>) -> (f64, f64, f64) {
+    v.sort_by(f64::total_cmp);
+    let q = |q: f64| percentile(&v, q).unwrap_or(f64::NAN);
+    (q(0.5), q(0.95), v.last().copied().unwrap_or(0.0))
+}
+
+fn main() {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a one-thread pool");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/eaae_pillars.toml");
+    let shipped = load(path).unwrap_or_else(|e| panic!("{e}"));
+    let seeds: Vec<u64> = std::env::var("DECISION_SEEDS")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![1]);
+    let loops: usize = std::env::var("DECISION_LOOPS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
+    let mut digest_file = std::env::var("DECISION_DIGEST")
+        .ok()
+        .map(|p| std::fs::File::create(p).expect("a writable digest file"));
+
+    println!("decision bench, one core (EAAE Pillars, decisions replayed from the mission)");
+    for seed in seeds {
+        let mut sim = Sim::build(&shipped, seed).unwrap_or_else(|e| panic!("{e}"));
+        sim.world.init_resource::<Snapshots>();
+        sim.add_systems(
+            snapshot
+                .in_set(DecideStep::Propose)
+                .before(propose_candidates),
+        );
+        let (outcome, _) = pool.install(|| sim.run_to_end());
+        let snapshots = std::mem::take(&mut sim.world.resource_mut::<Snapshots>().0);
+        drop(sim);
+
+        let (mut clustering, mut trajectories, mut energy, mut means, mut totals) =
+            (vec![], vec![], vec![], vec![], vec![]);
+        let mut candidates = 0usize;
+        let mut targets = 0usize;
+        for (k, s) in snapshots.iter().enumerate() {
+            let (t_ms, planned) = pool.install(|| fastest_ms(|| plan(s)));
+            let (e_ms, _) = pool.install(|| {
+                fastest_ms(|| roll_out_candidates(&s.airframe, &s.flight, &planned, &s.config))
+            });
+            let (m_ms, _) = fastest_ms(|| {
+                let mut rng = RunSeed(seed).stream(stream::CLUSTERING, k as u64);
+                divisive_two_means(&s.points, s.r_max_m, &mut rng).len()
+            });
+            candidates += planned.len();
+            targets += s.clusters.len();
+            if let Some(file) = &mut digest_file {
+                writeln!(
+                    file,
+                    "seed {seed} decision {k}: {} clusters, {} planned {:?}, digest {:016x}",
+                    s.clusters.len(),
+                    planned.len(),
+                    planned
+                        .iter()
+                        .map(|c| (c.target, c.viewpoint))
+                        .collect::<Vec<_>>(),
+                    digest(&planned)
+                )
+                .expect("digest written");
+            }
+            clustering.push(s.clustering_ms);
+            trajectories.push(t_ms);
+            energy.push(e_ms);
+            means.push(m_ms);
+            totals.push(s.clustering_ms + t_ms + e_ms);
+        }
+        for _ in 0..loops {
+            for s in &snapshots {
+                std::hint::black_box(pool.install(|| plan(s)));
+            }
+        }
+        let n = snapshots.len().max(1) as f64;
+        println!(
+            "seed {seed}: {} decisions ({:.1} clusters, {:.1} candidates each), {outcome:?}",
+            snapshots.len(),
+            targets as f64 / n,
+            candidates as f64 / n
+        );
+        for (name, v) in [
+            ("total", totals),
+            ("clustering (in place)", clustering),
+            ("  of it 2-means", means),
+            ("trajectories", trajectories),
+            ("energy", energy),
+        ] {
+            let mean = v.iter().sum::<f64>() / n;
+            let (p50, p95, max) = quantiles(v);
+            println!(
+                "  {name:<22} ms: p50 {p50:7.2}  p95 {p95:7.2}  max {max:7.2}  mean {mean:7.2}"
+            );
+        }
+    }
+}

@@ -10,7 +10,6 @@ use bevy_ecs::system::SystemState;
 use uavex::components::exploration::{Chosen, DecisionLog, GoalKind, GoalOutcome};
 use uavex::components::map::MapConfig;
 use uavex::components::sim::Outcome;
-use uavex::components::uav::UavEnded;
 use uavex::components::world::WorldGeometry;
 use uavex::engine::exploration::{
     BudgetSpec, CandidateCount, ExploreSpec, StrategyName, decisions_csv,
@@ -24,7 +23,6 @@ use uavex::systems::exploration::DecideStep;
 use uavex::systems::exploration::strategy::{
     CandidateQuery, ClassicStrategy, Deciding, choosable, first_min_by,
 };
-use uavex::systems::flight::FlightEnergy;
 use uavex::systems::mapping::MapReader;
 
 /// A shipped scene with its UAV exploring by `strategy`.

@@ -287,8 +287,10 @@ pub fn propose_candidates(
                 None => any_affordable = true,
             }
         }
+        // Home when there were goals but none affordable; with nothing left to explore the
+        // mission is complete where it is.
         let go_home = match (&returns, any_affordable) {
-            (Some(_), false) => super::budget::plan_home(
+            (Some(_), false) if !planned.is_empty() => super::budget::plan_home(
                 &grid.0,
                 &start,
                 explorer.home.as_dvec3(),
@@ -297,11 +299,11 @@ pub fn propose_candidates(
             ),
             _ => None,
         };
-        let clustering_ms = 0.0;
         commands.entity(uav).insert(PendingDecision {
             clusters: targets.len(),
             timing: DecisionTiming {
-                clustering_ms,
+                // Measured around the clustering step; the commit fills it in.
+                clustering_ms: 0.0,
                 trajectory_ms,
                 energy_ms,
                 total_ms: trajectory_ms + energy_ms,

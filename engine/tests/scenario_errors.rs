@@ -146,7 +146,7 @@ fn unknown_kinds_name_what_this_build_knows() {
         "uav[0].behaviour.kind",
         18,
         8,
-        "unknown behaviour 'eaae' for uav[0]: this build knows: scripted, waypoints, coverage",
+        "unknown behaviour 'eaae' for uav[0]: this build knows: scripted, waypoints, coverage, explore",
     );
     assert_only(
         &with("kind = \"depth_camera\"", "kind = \"depth-camera\""),
@@ -194,7 +194,7 @@ fn missing_fields_point_at_their_table() {
         "uav[0].behaviour.kind",
         17,
         1,
-        "required field is missing; this build knows: scripted, waypoints, coverage",
+        "required field is missing; this build knows: scripted, waypoints, coverage, explore",
     );
     assert_only(
         &with("time_limit_s = 60.0", ""),
@@ -274,7 +274,7 @@ beams_h = "many"
 [[uav]]
 name = "b"
 start = { position = [1.0, 1.0, 1.0] }
-behaviour = { kind = "explore" }
+behaviour = { kind = "patrol" }
 "#;
     let all = diagnostics(text);
     let got: Vec<(usize, &str, &str)> = all
@@ -304,7 +304,7 @@ behaviour = { kind = "explore" }
         (
             36,
             "uav[1].behaviour.kind",
-            "unknown behaviour 'explore' for uav[1]: this build knows: scripted, waypoints, coverage",
+            "unknown behaviour 'patrol' for uav[1]: this build knows: scripted, waypoints, coverage, explore",
         ),
         // Meaning, of every piece that decoded, in file order.
         (

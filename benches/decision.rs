@@ -40,8 +40,8 @@ use uavex_engine::scenario::load;
 use uavex_engine::sim::Sim;
 use uavex_systems::exploration::DecideStep;
 use uavex_systems::exploration::propose::{
-    ClusterTarget, PlannedCandidate, plan_decision, planning_start, propose_candidates,
-    roll_out_candidates,
+    ClusterTarget, PlannedCandidate, cluster_targets, plan_decision, planning_start,
+    propose_candidates, roll_out_candidates,
 };
 use uavex_systems::flight::ecs::ReferenceTrajectory;
 use uavex_systems::flight::{Completion, FlightState, RolloutConfig};
@@ -104,23 +104,7 @@ fn snapshot(
     std::hint::black_box(found);
     let config = map.config.clone();
     let points: Vec<Vec3> = set.iter().map(|k| config.center_of(k)).collect();
-    let mut all: Vec<ClusterTarget> = clusters
-        .iter()
-        .map(|(entity, cluster, viewpoints)| ClusterTarget {
-            entity,
-            centroid: cluster.centroid,
-            size: cluster.size,
-            viewpoints: viewpoints.0.clone(),
-        })
-        .collect();
-    // As `propose_candidates` orders them.
-    all.sort_by(|a, b| {
-        a.centroid
-            .to_array()
-            .map(f32::to_bits)
-            .cmp(&b.centroid.to_array().map(f32::to_bits))
-            .then(a.size.cmp(&b.size))
-    });
+    let all = cluster_targets(&clusters);
     for (explorer, airframe, state, reference) in &uavs {
         let s = &explorer.settings;
         snapshots.0.push(Snapshot {

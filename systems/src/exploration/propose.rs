@@ -157,6 +157,30 @@ pub fn plan_decision(
     (near, planned)
 }
 
+/// The reachable clusters as planning targets, ordered by centroid then size: entity order is
+/// an accident of storage, and the decision must not depend on it.
+pub fn cluster_targets(
+    clusters: &Query<(Entity, &FrontierCluster, &Viewpoints), With<Reachable>>,
+) -> Vec<ClusterTarget> {
+    let mut all: Vec<ClusterTarget> = clusters
+        .iter()
+        .map(|(entity, cluster, viewpoints)| ClusterTarget {
+            entity,
+            centroid: cluster.centroid,
+            size: cluster.size,
+            viewpoints: viewpoints.0.clone(),
+        })
+        .collect();
+    all.sort_by(|a, b| {
+        a.centroid
+            .to_array()
+            .map(f32::to_bits)
+            .cmp(&b.centroid.to_array().map(f32::to_bits))
+            .then(a.size.cmp(&b.size))
+    });
+    all
+}
+
 /// Candidates of this decision, for the commit (how many clusters it saw, its timings, the
 /// way home when nothing was affordable).
 #[derive(Component, Debug, Clone)]
@@ -190,23 +214,7 @@ pub fn propose_candidates(
         return;
     }
     grid.0.refresh(&map);
-    let mut all: Vec<ClusterTarget> = clusters
-        .iter()
-        .map(|(entity, cluster, viewpoints)| ClusterTarget {
-            entity,
-            centroid: cluster.centroid,
-            size: cluster.size,
-            viewpoints: viewpoints.0.clone(),
-        })
-        .collect();
-    // Entity order is an accident of storage: order by position for determinism.
-    all.sort_by(|a, b| {
-        a.centroid
-            .to_array()
-            .map(f32::to_bits)
-            .cmp(&b.centroid.to_array().map(f32::to_bits))
-            .then(a.size.cmp(&b.size))
-    });
+    let all = cluster_targets(&clusters);
     let time_s = clock.time_s();
     for (uav, explorer, airframe, state, reference, energy) in &uavs {
         let settings = &explorer.settings;

@@ -6,7 +6,13 @@
 //!   (1,080 beams, 20 m).
 //! - `sense_and_map`: one thesis-camera frame swept and integrated into a warmed-up 0.1 m map
 //!   (all chunks exist, the steady state of a run), with the auto grid (55 x 41 = 2,255 rays)
-//!   and with one ray per pixel (307,200 rays); `sweep_only` is the sensing part alone.
+//!   and with one ray per pixel (307,200 rays); `sweep_only` is the sensing part alone. The same
+//!   frame again and again: its free space is saturated after a few frames, so this is the
+//!   cost of a camera at rest.
+//! - `flight`: the camera flown around the three pillars at 3 m/s (the heading snapping at each
+//!   corner), 30 frames per second, each swept and integrated in turn into a map that starts
+//!   empty: the cost of frames in flight, where each sees new space next to saturated space.
+//!   Throughput is in frames.
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use glam::{DVec3, Quat, Vec3};
@@ -17,7 +23,7 @@ use uavex_components::sim::RunSeed;
 use uavex_components::world::WorldGeometry;
 use uavex_engine::scenario;
 use uavex_engine::world::build_world;
-use uavex_systems::mapping::{ChunkStore, ScanRays, integrate_scan};
+use uavex_systems::mapping::{ChunkStore, ScanRays, ScanReport, integrate_scan};
 use uavex_systems::sensing::{
     LidarBeams, PinholeCamera, RayGrid, RayPattern, SensorPose, SweepScratch, camera_pattern,
     lidar_pattern, sweep,
@@ -179,5 +185,83 @@ fn sense_and_map(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, raycast, sense_and_map);
+/// Camera poses every 1/30 s along a loop around the pillars at 3 m/s, 1.25 m high, looking
+/// along the direction of travel (698 frames).
+fn flight_poses() -> Vec<SensorPose> {
+    const CORNERS: [[f32; 2]; 7] = [
+        [0.0, 0.0],
+        [-7.5, 0.0],
+        [-7.5, -8.5],
+        [7.5, -8.5],
+        [7.5, 7.5],
+        [-7.5, 7.5],
+        [-7.5, 0.0],
+    ];
+    let step = 3.0 / 30.0;
+    let mut poses = Vec::new();
+    for leg in CORNERS.windows(2) {
+        let (a, b) = (
+            Vec3::new(leg[0][0], leg[0][1], 1.25),
+            Vec3::new(leg[1][0], leg[1][1], 1.25),
+        );
+        let heading = b - a;
+        let rotation = Quat::from_rotation_z(heading.y.atan2(heading.x));
+        let frames = (heading.length() / step).round() as usize;
+        poses.extend((0..frames).map(|i| SensorPose {
+            origin: a + heading * (i as f32 / frames as f32),
+            rotation,
+        }));
+    }
+    poses
+}
+
+fn flight(c: &mut Criterion) {
+    let (world, map) = pillars();
+    let increments = map
+        .increments(&SensorQuality::from_probabilities(0.7, 0.4, 0.0))
+        .unwrap();
+    let auto = camera_pattern(THESIS_CAMERA, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).unwrap();
+    let poses = flight_poses();
+    let mut scratch = SweepScratch::default();
+    let mut scan = Scan::default();
+    let mut fly = |report: &mut ScanReport| {
+        let mut store = ChunkStore::new(&map);
+        let mut totals = StatSums::default();
+        let mut id = None;
+        for &pose in &poses {
+            sweep(&auto, pose, &world, None, &mut scratch, &mut scan, 0.0);
+            let scan_id = ScanId::after(id);
+            id = Some(scan_id);
+            let r = integrate_scan(
+                &map,
+                scan_id,
+                ScanRays::of(&scan),
+                increments,
+                &mut store,
+                &mut totals,
+            )
+            .unwrap();
+            report.voxel_visits += r.voxel_visits;
+            report.skipped_voxels += r.skipped_voxels;
+        }
+        store.chunk_count()
+    };
+    let mut report = ScanReport::default();
+    fly(&mut report);
+    eprintln!(
+        "flight: {} frames, {:.0} voxel visits per frame, {:.1} % passed over in saturated bricks",
+        poses.len(),
+        report.voxel_visits as f64 / poses.len() as f64,
+        100.0 * report.skipped_voxels as f64 / report.voxel_visits as f64
+    );
+    let mut group = c.benchmark_group("flight");
+    group.sample_size(10);
+    group.throughput(Throughput::Elements(poses.len() as u64));
+    group.bench_function("thesis_camera_auto_frames", |b| {
+        b.iter(|| black_box(fly(&mut ScanReport::default())))
+    });
+    group.finish();
+}
+
+criterion_group!(benches, raycast, sense_and_map, flight);
 criterion_main!(benches);

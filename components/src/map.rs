@@ -19,8 +19,8 @@ mod index;
 mod stats;
 
 pub use chunk::{
-    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ScanId, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk, VoxelState,
-    local_index, local_key,
+    BRICK_EDGE, BRICK_VOXELS, CHUNK_BRICKS, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ScanId,
+    UNKNOWN_LOG_ODDS, Voxel, VoxelChunk, VoxelState, brick_of, local_index, local_key,
 };
 pub use config::{
     LogOddsIncrements, MAX_BOX_VOXELS, MapConfig, MapConfigError, MapSettings, floor_to_key,

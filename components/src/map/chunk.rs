@@ -138,16 +138,39 @@ impl Voxel {
     }
 }
 
-/// The voxels of one chunk, indexed by [`local_index`], plus the stamp epoch.
+/// Edge of a brick in voxels: a chunk is tiled by 4 x 4 x 4 bricks of 4^3 voxels.
+pub const BRICK_EDGE: i32 = 4;
+/// Voxels in one brick.
+pub const BRICK_VOXELS: u8 = 64;
+/// Bricks in one chunk.
+pub const CHUNK_BRICKS: usize = 64;
+
+/// The brick (0..64, x fastest) holding the voxel with local index `index` ([`local_index`]):
+/// bits 2-3 of each local coordinate.
+#[inline(always)]
+pub fn brick_of(index: usize) -> usize {
+    ((index >> 2) & 0x3) | ((index >> 4) & 0xC) | ((index >> 6) & 0x30)
+}
+
+/// The voxels of one chunk, indexed by [`local_index`], plus the stamp epoch and, per brick,
+/// how many of its voxels are saturated free.
 ///
 /// One scan updates each voxel at most once (common.md §1): the update stamps the voxel with the
 /// scan's [`ScanId::stamp`] and skips voxels already stamped. Stamps are valid only while
 /// `epoch == scan.epoch()`; the first touch in a new epoch clears them (once every 65,535 scans
 /// per chunk), so no per-scan clearing or sorting is ever needed.
+///
+/// **Saturation.** A miss cannot change a voxel already at the lower clamping bound, so a ray
+/// crossing a brick whose 64 voxels are all there changes nothing in it, and the map update
+/// walks past such bricks without visiting their voxels. The count per brick is kept by the
+/// map update ([`Self::voxels_and_saturation_mut`]); it is a lower bound of the true count at
+/// all times (writes through [`Self::voxels_mut`] reset it to zero, and decrements saturate), so
+/// a brick reported full is always truly saturated.
 #[derive(Component, Debug, Clone, PartialEq, Eq)]
 pub struct VoxelChunk {
     voxels: Box<[Voxel; CHUNK_VOXELS]>,
     epoch: u32,
+    saturated: [u8; CHUNK_BRICKS],
 }
 
 impl Default for VoxelChunk {
@@ -162,6 +185,7 @@ impl VoxelChunk {
         Self {
             voxels: Box::new([Voxel::UNKNOWN; CHUNK_VOXELS]),
             epoch: 0,
+            saturated: [0; CHUNK_BRICKS],
         }
     }
 
@@ -170,10 +194,28 @@ impl VoxelChunk {
         &self.voxels
     }
 
-    /// Mutable voxels, for the mapping stage (which keeps [`super::ChunkStats`] in step).
+    /// Mutable voxels, for tools and tests that write a map by hand. Forgets the saturation
+    /// counts (they stay a lower bound whatever is written); the map update uses
+    /// [`Self::voxels_and_saturation_mut`] instead.
     #[inline]
     pub fn voxels_mut(&mut self) -> &mut [Voxel; CHUNK_VOXELS] {
+        self.saturated = [0; CHUNK_BRICKS];
         &mut self.voxels
+    }
+
+    /// Mutable voxels and the per-brick saturation counts, for the map update, which keeps the
+    /// counts (and [`super::ChunkStats`]) in step with every write.
+    #[inline]
+    pub fn voxels_and_saturation_mut(
+        &mut self,
+    ) -> (&mut [Voxel; CHUNK_VOXELS], &mut [u8; CHUNK_BRICKS]) {
+        (&mut self.voxels, &mut self.saturated)
+    }
+
+    /// Whether every voxel of brick `brick` is known to be at the lower clamping bound.
+    #[inline]
+    pub fn brick_saturated(&self, brick: usize) -> bool {
+        self.saturated[brick % CHUNK_BRICKS] == BRICK_VOXELS
     }
 
     /// Stored log-odds (milli units) at local index `index`.
@@ -289,6 +331,30 @@ mod tests {
         chunk.begin_scan(ScanId(0x3_0005));
         assert_eq!(chunk.voxels()[7].stamp, 0);
         assert_eq!(chunk.epoch(), 3);
+    }
+
+    #[test]
+    fn bricks_tile_the_chunk_by_fours() {
+        let mut voxels_per_brick = [0u8; CHUNK_BRICKS];
+        for z in 0..CHUNK_EDGE {
+            for y in 0..CHUNK_EDGE {
+                for x in 0..CHUNK_EDGE {
+                    let brick = brick_of(local_index(IVec3::new(x, y, z)));
+                    assert_eq!(brick as i32, x / 4 + 4 * (y / 4) + 16 * (z / 4));
+                    voxels_per_brick[brick] += 1;
+                }
+            }
+        }
+        assert!(voxels_per_brick.iter().all(|&n| n == BRICK_VOXELS));
+    }
+
+    #[test]
+    fn writing_voxels_by_hand_forgets_saturation() {
+        let mut chunk = VoxelChunk::new();
+        chunk.voxels_and_saturation_mut().1[3] = BRICK_VOXELS;
+        assert!(chunk.brick_saturated(3));
+        chunk.voxels_mut()[0].log_odds = 100;
+        assert!(!chunk.brick_saturated(3));
     }
 
     #[test]

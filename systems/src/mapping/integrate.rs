@@ -9,13 +9,18 @@
 //!
 //! Hence a voxel that is both an end point and crossed counts as occupied, and each voxel is
 //! updated at most once per scan, with no per-scan clearing, sorting or allocation.
+//!
+//! Pass 2 walks through bricks whose voxels are all saturated free brick by brick
+//! ([`walk_saturated`]): a miss changes none of them, so the map is the same as if each voxel
+//! had been visited.
 
+use super::brick::walk_saturated;
 use super::dda::{T_ONE, VoxelWalk, clip_segment, to_fixed};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
 use uavex_components::map::{
-    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
-    StatSums, StatTables, VoxelChunk, floor_to_key, local_index,
+    BRICK_VOXELS, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig,
+    ScanId, StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
 };
 use uavex_components::sensor::Scan;
 
@@ -64,6 +69,8 @@ pub struct ScanReport {
     pub voxel_visits: u64,
     /// Voxels whose log-odds changed.
     pub changed_voxels: u64,
+    /// Of the visits, those passed over in saturated bricks (no update needed).
+    pub skipped_voxels: u64,
 }
 
 /// A scan that cannot be integrated (refused before anything is written).
@@ -186,8 +193,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
         chunk.begin_scan(self.scan);
         let before = *stats;
-        let voxel = &mut chunk.voxels_mut()[local_index(key) & (CHUNK_VOXELS - 1)];
-        let changed = update_voxel(voxel, rule, self.tables, stats);
+        let (voxels, saturated) = chunk.voxels_and_saturation_mut();
+        let index = local_index(key) & (CHUNK_VOXELS - 1);
+        let changed = update_voxel(voxels, index, saturated, rule, self.tables, stats);
         self.totals.add_change(&before, stats);
         if changed {
             self.report.changed_voxels += 1;
@@ -227,7 +235,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
     ///   dependency, floating-point compare and add three to four (measured: the same loop on
     ///   f64 took 1.2 to 1.4 times as long);
     /// - one integer `cursor` holds both the voxel index in the chunk and the chunk-local
-    ///   coordinates, biased so that leaving the chunk shows in one mask test.
+    ///   coordinates, biased so that leaving the chunk shows in one mask test;
+    /// - on entering a brick of saturated free voxels, the walk goes on brick by brick
+    ///   ([`walk_saturated`]) while a miss cannot change them (a non-positive miss increment).
     ///
     /// No lookups, no bounds checks.
     fn walk_fast(
@@ -244,18 +254,56 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let [cx, cy, cz] = [mx * CURSOR_X, my * CURSOR_Y, mz * CURSOR_Z];
         let mut key = walk.key();
         let mut stop = false;
+        let skip_saturated = rule.delta <= 0;
         while visits > 0 && !stop {
             let coord = ChunkCoord::of_key(key);
             let flat = self.grid.flat_unchecked(coord);
             let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
             chunk.begin_scan(self.scan);
             let before = *stats;
-            let voxels = chunk.voxels_mut();
+            let (voxels, saturated) = chunk.voxels_and_saturation_mut();
             let mut cursor = Cursor::at(key);
             let mut changed = 0u64;
+            // The brick whose saturation was last looked at (none yet).
+            let mut brick = u64::MAX;
             loop {
-                let voxel = &mut voxels[cursor.index()];
-                changed += u64::from(update_voxel(voxel, rule, self.tables, stats));
+                let index = cursor.index();
+                if skip_saturated && cursor.brick() != brick {
+                    brick = cursor.brick();
+                    if saturated[brick_of(index)] == BRICK_VOXELS
+                        && let Some(stretch) = walk_saturated(
+                            cursor.local_array(),
+                            [mx, my, mz],
+                            [tx, ty, tz],
+                            [dtx, dty, dtz],
+                            t_safe,
+                            saturated,
+                        )
+                    {
+                        // Every crossing is before `t_safe`, hence before the segment's end: the
+                        // voxels passed are on the walk, and the one entered is too, unless it
+                        // is the excluded end voxel of a hit (then no visit is left).
+                        let passed = stretch.voxels_passed() as u64;
+                        debug_assert!(passed <= visits);
+                        visits -= passed;
+                        self.report.skipped_voxels += passed;
+                        [tx, ty, tz] = stretch.boundary_times;
+                        let [kx, ky, kz] = stretch.crossings;
+                        cursor.0 = cursor.0.wrapping_add((kx * cx + ky * cy + kz * cz) as u64);
+                        if visits == 0 || cursor.left_chunk() {
+                            break;
+                        }
+                        continue;
+                    }
+                }
+                changed += u64::from(update_voxel(
+                    voxels,
+                    index,
+                    saturated,
+                    rule,
+                    self.tables,
+                    stats,
+                ));
                 visits -= 1;
                 if visits == 0 {
                     break;
@@ -331,6 +379,19 @@ impl Cursor {
     #[inline(always)]
     fn left_chunk(self) -> bool {
         self.0 & Self::NIBBLES != Self::INSIDE
+    }
+
+    /// The bits that tell which brick of the chunk the cursor is in: bits 2-3 of each local
+    /// coordinate.
+    #[inline(always)]
+    fn brick(self) -> u64 {
+        self.0 & 0x000C_0C0C_0000_0000
+    }
+
+    /// Local coordinates inside the chunk (0..16 per axis, while inside).
+    #[inline(always)]
+    fn local_array(self) -> [i64; 3] {
+        [32, 40, 48].map(|shift| ((self.0 >> shift) & 0xFF) as i64 - i64::from(CHUNK_EDGE))
     }
 
     /// Local coordinates (-1 or 16 on the axis just stepped out of the chunk).

@@ -1,6 +1,8 @@
 //! The log-odds update of one voxel by one scan (common.md §1, OctoMap semantics).
 
-use uavex_components::map::{StatSums, StatTables, UNKNOWN_LOG_ODDS, Voxel};
+use uavex_components::map::{
+    CHUNK_BRICKS, CHUNK_VOXELS, StatSums, StatTables, UNKNOWN_LOG_ODDS, Voxel, brick_of,
+};
 
 /// How one scan changes the voxels it updates with one kind of measurement (hit or miss).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -14,16 +16,21 @@ pub struct UpdateRule {
     pub max: i32,
 }
 
-/// Applies `rule` to `voxel` unless this scan already updated it: stamps it, adds the increment
-/// to its log-odds (an unknown voxel starts from l = 0, p = 0.5), clamps, and keeps `stats` in
-/// step (old value out, new value in). Returns whether the log-odds changed.
+/// Applies `rule` to voxel `index` of a chunk's `voxels` unless this scan already updated it:
+/// stamps it, adds the increment to its log-odds (an unknown voxel starts from l = 0, p = 0.5),
+/// clamps, and keeps `stats` in step (old value out, new value in), and `saturated`, the count
+/// per brick of voxels at the lower bound (see [`uavex_components::map::VoxelChunk`]). Returns
+/// whether the log-odds changed.
 #[inline(always)]
 pub fn update_voxel(
-    voxel: &mut Voxel,
+    voxels: &mut [Voxel; CHUNK_VOXELS],
+    index: usize,
+    saturated: &mut [u8; CHUNK_BRICKS],
     rule: UpdateRule,
     tables: &StatTables,
     stats: &mut StatSums,
 ) -> bool {
+    let voxel = &mut voxels[index % CHUNK_VOXELS];
     if voxel.stamp == rule.stamp {
         return false;
     }
@@ -32,13 +39,21 @@ pub fn update_voxel(
     let known = old != UNKNOWN_LOG_ODDS;
     let base = if known { i32::from(old) } else { 0 };
     let new = (base + rule.delta).clamp(rule.min, rule.max) as i16;
+    let brick = brick_of(index % CHUNK_VOXELS);
     if known {
         if new == old {
             return false;
         }
         stats.remove_voxel(old, tables);
+        if i32::from(old) == rule.min {
+            // The count is a lower bound (see `VoxelChunk`): never below zero.
+            saturated[brick] = saturated[brick].saturating_sub(1);
+        }
     }
     stats.add_voxel(new, tables);
+    if i32::from(new) == rule.min {
+        saturated[brick] += 1;
+    }
     voxel.log_odds = new;
     true
 }
@@ -46,9 +61,12 @@ pub fn update_voxel(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use uavex_components::map::VoxelChunk;
 
     const TABLES_MIN: i16 = -1992;
     const TABLES_MAX: i16 = 3476;
+    /// The voxel probed: local index 7, in brick 1.
+    const INDEX: usize = 7;
 
     fn rule(stamp: u16, delta: i32) -> UpdateRule {
         UpdateRule {
@@ -59,66 +77,111 @@ mod tests {
         }
     }
 
+    /// One voxel of a chunk under updates, with its chunk's statistics.
+    struct Probe {
+        chunk: VoxelChunk,
+        tables: StatTables,
+        stats: StatSums,
+    }
+
+    impl Probe {
+        fn new(min: i16, max: i16) -> Self {
+            Self {
+                chunk: VoxelChunk::new(),
+                tables: StatTables::new(min, max),
+                stats: StatSums::default(),
+            }
+        }
+
+        fn update(&mut self, rule: UpdateRule) -> bool {
+            let (voxels, saturated) = self.chunk.voxels_and_saturation_mut();
+            update_voxel(
+                voxels,
+                INDEX,
+                saturated,
+                rule,
+                &self.tables,
+                &mut self.stats,
+            )
+        }
+
+        fn voxel(&self) -> Voxel {
+            self.chunk.voxels()[INDEX]
+        }
+
+        fn saturated(&mut self) -> u8 {
+            self.chunk.voxels_and_saturation_mut().1[brick_of(INDEX)]
+        }
+    }
+
     #[test]
     fn hits_and_misses_accumulate_and_clamp() {
-        let tables = StatTables::new(TABLES_MIN, TABLES_MAX);
-        let mut stats = StatSums::default();
-        let mut v = Voxel::UNKNOWN;
+        let mut p = Probe::new(TABLES_MIN, TABLES_MAX);
         // One hit from unknown: l = 0.847.
-        assert!(update_voxel(&mut v, rule(1, 847), &tables, &mut stats));
-        assert_eq!(v.log_odds, 847);
-        assert_eq!(stats.counts, [0, 1]);
+        assert!(p.update(rule(1, 847)));
+        assert_eq!(p.voxel().log_odds, 847);
+        assert_eq!(p.stats.counts, [0, 1]);
         // Same scan again: no second update.
-        assert!(!update_voxel(&mut v, rule(1, 847), &tables, &mut stats));
-        assert_eq!(v.log_odds, 847);
+        assert!(!p.update(rule(1, 847)));
+        assert_eq!(p.voxel().log_odds, 847);
         // Hits in later scans: 1694, 2541, 3388, then clamped at 3.476 and stays there.
         for (stamp, expected) in [(2, 1694), (3, 2541), (4, 3388), (5, 3476)] {
-            assert!(update_voxel(&mut v, rule(stamp, 847), &tables, &mut stats));
-            assert_eq!(v.log_odds, expected);
+            assert!(p.update(rule(stamp, 847)));
+            assert_eq!(p.voxel().log_odds, expected);
         }
-        assert!(!update_voxel(&mut v, rule(6, 847), &tables, &mut stats));
-        assert_eq!(v.log_odds, 3476);
+        assert!(!p.update(rule(6, 847)));
+        assert_eq!(p.voxel().log_odds, 3476);
         // Misses bring it down: 3071, ..., crossing 0 to free, then clamped at -1.992.
         let mut l = 3476;
         let mut stamp = 7;
         while l > -1992 {
             l = (l - 405).max(-1992);
-            assert!(update_voxel(&mut v, rule(stamp, -405), &tables, &mut stats));
-            assert_eq!(v.log_odds, l);
+            assert!(p.update(rule(stamp, -405)));
+            assert_eq!(p.voxel().log_odds, l);
             stamp += 1;
         }
-        assert_eq!(v.log_odds, -1992);
-        assert_eq!(stats.counts, [1, 0]);
-        assert_eq!(stats.entropy[0], i64::from(tables.entry(-1992).entropy));
-        assert_eq!(stats.entropy[1], 0);
+        assert_eq!(p.voxel().log_odds, -1992);
+        assert_eq!(p.saturated(), 1, "the voxel reached the lower bound once");
+        // A further miss changes nothing; a hit takes it off the bound, and the count back.
+        assert!(!p.update(rule(stamp, -405)));
+        assert!(p.update(rule(stamp + 1, 847)));
+        assert_eq!((p.voxel().log_odds, p.saturated()), (-1145, 0));
+        for s in stamp + 2..stamp + 5 {
+            assert!(p.update(rule(s, -405)));
+        }
+        assert_eq!((p.voxel().log_odds, p.saturated()), (-1992, 1));
+        assert_eq!(p.stats.counts, [1, 0]);
+        assert_eq!(p.stats.entropy[0], i64::from(p.tables.entry(-1992).entropy));
+        assert_eq!(p.stats.entropy[1], 0);
     }
 
     #[test]
     fn a_miss_on_unknown_gives_free() {
-        let tables = StatTables::new(TABLES_MIN, TABLES_MAX);
-        let mut stats = StatSums::default();
-        let mut v = Voxel::UNKNOWN;
-        assert!(update_voxel(&mut v, rule(9, -405), &tables, &mut stats));
-        assert_eq!((v.log_odds, v.stamp), (-405, 9));
-        assert_eq!(stats.counts, [1, 0]);
+        let mut p = Probe::new(TABLES_MIN, TABLES_MAX);
+        assert!(p.update(rule(9, -405)));
+        assert_eq!((p.voxel().log_odds, p.voxel().stamp), (-405, 9));
+        assert_eq!(p.stats.counts, [1, 0]);
         assert_eq!(
-            stats.uncertainty[0],
-            i64::from(tables.entry(-405).uncertainty)
+            p.stats.uncertainty[0],
+            i64::from(p.tables.entry(-405).uncertainty)
         );
+        assert_eq!(p.saturated(), 0);
     }
 
     #[test]
     fn an_increment_beyond_the_clamp_is_clamped_from_unknown() {
-        let tables = StatTables::new(-200, 300);
-        let mut stats = StatSums::default();
-        let mut v = Voxel::UNKNOWN;
+        let mut p = Probe::new(-200, 300);
         let r = UpdateRule {
             stamp: 1,
             delta: 847,
             min: -200,
             max: 300,
         };
-        assert!(update_voxel(&mut v, r, &tables, &mut stats));
-        assert_eq!(v.log_odds, 300);
+        assert!(p.update(r));
+        assert_eq!(p.voxel().log_odds, 300);
+        // A miss as large as the range saturates an unknown voxel at once.
+        let mut q = Probe::new(-200, 300);
+        assert!(q.update(UpdateRule { delta: -847, ..r }));
+        assert_eq!((q.voxel().log_odds, q.saturated()), (-200, 1));
     }
 }

@@ -166,11 +166,19 @@ pub fn brick_of(index: usize) -> usize {
 /// map update ([`Self::voxels_and_saturation_mut`]); it is a lower bound of the true count at
 /// all times (writes through [`Self::voxels_mut`] reset it to zero, and decrements saturate), so
 /// a brick reported full is always truly saturated.
+///
+/// **State version.** Most updates only move a voxel's log-odds within its state (a free voxel
+/// seen free again); frontiers and traversability depend on the states alone (unknown, free,
+/// occupied). [`Self::state_version`] changes whenever some voxel's state may have changed (the
+/// map update bumps it when one did, a write through [`Self::voxels_mut`] always), so such
+/// consumers skip chunks that are `Changed` but whose states are not
+/// (`uavex_systems::mapping::StateVersions`).
 #[derive(Component, Debug, Clone, PartialEq, Eq)]
 pub struct VoxelChunk {
     voxels: Box<[Voxel; CHUNK_VOXELS]>,
     epoch: u32,
     saturated: [u8; CHUNK_BRICKS],
+    state_version: u32,
 }
 
 impl Default for VoxelChunk {
@@ -186,6 +194,7 @@ impl VoxelChunk {
             voxels: Box::new([Voxel::UNKNOWN; CHUNK_VOXELS]),
             epoch: 0,
             saturated: [0; CHUNK_BRICKS],
+            state_version: 0,
         }
     }
 
@@ -195,12 +204,27 @@ impl VoxelChunk {
     }
 
     /// Mutable voxels, for tools and tests that write a map by hand. Forgets the saturation
-    /// counts (they stay a lower bound whatever is written); the map update uses
-    /// [`Self::voxels_and_saturation_mut`] instead.
+    /// counts (they stay a lower bound whatever is written) and bumps the state version (any
+    /// state may change); the map update uses [`Self::voxels_and_saturation_mut`] instead.
     #[inline]
     pub fn voxels_mut(&mut self) -> &mut [Voxel; CHUNK_VOXELS] {
         self.saturated = [0; CHUNK_BRICKS];
+        self.note_state_change();
         &mut self.voxels
+    }
+
+    /// A counter that changes whenever some voxel's state may have changed (see the type's
+    /// documentation); equal versions mean equal states.
+    #[inline]
+    pub fn state_version(&self) -> u32 {
+        self.state_version
+    }
+
+    /// Records that some voxel's state changed (the map update calls it after writing through
+    /// [`Self::voxels_and_saturation_mut`]).
+    #[inline]
+    pub fn note_state_change(&mut self) {
+        self.state_version = self.state_version.wrapping_add(1);
     }
 
     /// Mutable voxels and the per-brick saturation counts, for the map update, which keeps the
@@ -349,12 +373,14 @@ mod tests {
     }
 
     #[test]
-    fn writing_voxels_by_hand_forgets_saturation() {
+    fn writing_voxels_by_hand_forgets_saturation_and_bumps_the_state_version() {
         let mut chunk = VoxelChunk::new();
         chunk.voxels_and_saturation_mut().1[3] = BRICK_VOXELS;
         assert!(chunk.brick_saturated(3));
+        let version = chunk.state_version();
         chunk.voxels_mut()[0].log_odds = 100;
         assert!(!chunk.brick_saturated(3));
+        assert_ne!(chunk.state_version(), version);
     }
 
     #[test]

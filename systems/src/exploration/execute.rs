@@ -16,7 +16,9 @@
 use super::commit::{DecisionBackoff, energy_drawn};
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
 use crate::mapping::MapReader;
-use crate::planning::{Traversability, TraversableGrid, plan_local, remains_traversable};
+use crate::planning::{
+    Traversability, TraversableGrid, plan_local, refresh_along, remains_traversable,
+};
 use crate::trajectory::DynamicLimits;
 use bevy_ecs::prelude::*;
 use glam::IVec3;
@@ -214,9 +216,20 @@ pub fn fly_to_goals(
         if !due && !check_due {
             continue;
         }
-        grid.0.refresh(&map);
         let limits = DynamicLimits::of(airframe);
         let elapsed = reference.elapsed(time_s);
+        if due {
+            grid.0.refresh(&map);
+        } else {
+            // A check only: the grid need be current where the trajectory goes.
+            refresh_along(
+                &mut grid.0,
+                &map,
+                reference.trajectory.as_ref(),
+                elapsed.max(0.0),
+                limits.max_velocity,
+            );
+        }
         let blocked = !remains_traversable(
             &grid.0,
             reference.trajectory.as_ref(),
@@ -232,6 +245,7 @@ pub fn fly_to_goals(
             continue;
         }
         goal.flying_candidate = false;
+        grid.0.refresh(&map);
         match local_replan(&grid.0, &reference, &goal, settings, &limits, time_s) {
             Some(plan) => *reference = plan,
             None if blocked => {

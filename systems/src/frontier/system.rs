@@ -1,6 +1,6 @@
 //! The thin ECS side of frontier detection and clustering.
 
-use super::super::mapping::MapReader;
+use super::super::mapping::{MapReader, StateChanges};
 use super::assemble::{ClusterData, cluster_frontier, match_clusters};
 use super::detect::update_frontier_set;
 use bevy_ecs::prelude::*;
@@ -9,7 +9,7 @@ use uavex_components::frontier::{
     ClusterMembers, ClusterSettings, ClusteringCounter, FrontierCluster, FrontierSet, Reachable,
     Viewpoints,
 };
-use uavex_components::map::{ChunkCoord, VoxelChunk};
+use uavex_components::map::ChunkCoord;
 use uavex_components::sim::{RunSeed, stream};
 
 /// Inserts [`FrontierSet`] (empty), `settings`, and the [`ClusteringCounter`]. The clustering
@@ -20,17 +20,18 @@ pub fn insert_frontier_resources(world: &mut World, settings: ClusterSettings) {
     world.insert_resource(ClusteringCounter::default());
 }
 
-/// Stage::Frontier: update [`FrontierSet`] from the chunks whose [`VoxelChunk`] changed this
-/// tick (`Changed` includes chunks spawned since the last run). The resource is marked changed
+/// Stage::Frontier: update [`FrontierSet`] from the chunks whose `VoxelChunk` changed this
+/// tick (`Changed` includes chunks spawned since the last run) in a way that can move a
+/// frontier: some voxel's state changed ([`StateChanges`]). The resource is marked changed
 /// only when the set actually changed.
 pub fn update_frontiers(
-    changed: Query<&ChunkCoord, Changed<VoxelChunk>>,
+    mut changes: StateChanges,
     mut set: ResMut<FrontierSet>,
     map: MapReader,
     mut scratch: Local<Vec<ChunkCoord>>,
 ) {
     scratch.clear();
-    scratch.extend(changed.iter().copied());
+    changes.collect_into(&mut scratch);
     if scratch.is_empty() {
         return;
     }

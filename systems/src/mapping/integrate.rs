@@ -195,9 +195,12 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let before = *stats;
         let (voxels, saturated) = chunk.voxels_and_saturation_mut();
         let index = local_index(key) & (CHUNK_VOXELS - 1);
-        let changed = update_voxel(voxels, index, saturated, rule, self.tables, stats);
+        let change = update_voxel(voxels, index, saturated, rule, self.tables, stats);
+        if change.state_changed() {
+            chunk.note_state_change();
+        }
         self.totals.add_change(&before, stats);
-        if changed {
+        if change.changed() {
             self.report.changed_voxels += 1;
             self.chunks.mark_written(flat);
         }
@@ -264,6 +267,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let (voxels, saturated) = chunk.voxels_and_saturation_mut();
             let mut cursor = Cursor::at(key);
             let mut changed = 0u64;
+            let mut states_changed = false;
             // The brick whose saturation was last looked at (none yet).
             let mut brick = u64::MAX;
             loop {
@@ -296,14 +300,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
                         continue;
                     }
                 }
-                changed += u64::from(update_voxel(
-                    voxels,
-                    index,
-                    saturated,
-                    rule,
-                    self.tables,
-                    stats,
-                ));
+                let change = update_voxel(voxels, index, saturated, rule, self.tables, stats);
+                changed += u64::from(change.changed());
+                states_changed |= change.state_changed();
                 visits -= 1;
                 if visits == 0 {
                     break;
@@ -326,6 +325,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 }
             }
             key = coord.first_key() + cursor.local();
+            if states_changed {
+                chunk.note_state_change();
+            }
             self.totals.add_change(&before, stats);
             if changed > 0 {
                 self.report.changed_voxels += changed;

@@ -7,6 +7,8 @@
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
 //! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
+//! - [`state_changes`]: [`StateChanges`], the chunks whose voxel states changed (for consumers
+//!   that depend on states alone: frontiers, traversability).
 //! - [`system`]: the ECS system [`integrate_scans`] and [`insert_map_resources`].
 //!
 //! Wiring: insert the resources with [`insert_map_resources`] (plus `RunEnd`), and add
@@ -17,12 +19,14 @@ pub mod brick;
 pub mod dda;
 pub mod integrate;
 pub mod read;
+pub mod state_changes;
 pub mod store;
 pub mod system;
 pub mod update;
 
 pub use integrate::{ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan};
 pub use read::{MapReader, OccupancyMap, map_accuracy};
+pub use state_changes::StateChanges;
 pub use store::ChunkStore;
 pub use system::{MappingScratch, insert_map_resources, integrate_scans};
 

@@ -16,11 +16,33 @@ pub struct UpdateRule {
     pub max: i32,
 }
 
+/// What one update did to a voxel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum VoxelChange {
+    /// Nothing: already updated by this scan, or held at a clamping bound.
+    None,
+    /// The log-odds moved within the voxel's state (unknown, free, occupied).
+    LogOdds,
+    /// The voxel's state changed (it became known, or crossed l = 0).
+    State,
+}
+
+impl VoxelChange {
+    #[inline(always)]
+    pub fn changed(self) -> bool {
+        self != Self::None
+    }
+
+    #[inline(always)]
+    pub fn state_changed(self) -> bool {
+        self == Self::State
+    }
+}
+
 /// Applies `rule` to voxel `index` of a chunk's `voxels` unless this scan already updated it:
 /// stamps it, adds the increment to its log-odds (an unknown voxel starts from l = 0, p = 0.5),
 /// clamps, and keeps `stats` in step (old value out, new value in), and `saturated`, the count
-/// per brick of voxels at the lower bound (see [`uavex_components::map::VoxelChunk`]). Returns
-/// whether the log-odds changed.
+/// per brick of voxels at the lower bound (see [`uavex_components::map::VoxelChunk`]).
 #[inline(always)]
 pub fn update_voxel(
     voxels: &mut [Voxel; CHUNK_VOXELS],
@@ -29,10 +51,10 @@ pub fn update_voxel(
     rule: UpdateRule,
     tables: &StatTables,
     stats: &mut StatSums,
-) -> bool {
+) -> VoxelChange {
     let voxel = &mut voxels[index % CHUNK_VOXELS];
     if voxel.stamp == rule.stamp {
-        return false;
+        return VoxelChange::None;
     }
     voxel.stamp = rule.stamp;
     let old = voxel.log_odds;
@@ -42,7 +64,7 @@ pub fn update_voxel(
     let brick = brick_of(index % CHUNK_VOXELS);
     if known {
         if new == old {
-            return false;
+            return VoxelChange::None;
         }
         stats.remove_voxel(old, tables);
         if i32::from(old) == rule.min {
@@ -55,7 +77,12 @@ pub fn update_voxel(
         saturated[brick] += 1;
     }
     voxel.log_odds = new;
-    true
+    // States: unknown (not `known`), free (l < 0), occupied (l >= 0).
+    if known && (old < 0) == (new < 0) {
+        VoxelChange::LogOdds
+    } else {
+        VoxelChange::State
+    }
 }
 
 #[cfg(test)]
@@ -93,7 +120,7 @@ mod tests {
             }
         }
 
-        fn update(&mut self, rule: UpdateRule) -> bool {
+        fn change(&mut self, rule: UpdateRule) -> VoxelChange {
             let (voxels, saturated) = self.chunk.voxels_and_saturation_mut();
             update_voxel(
                 voxels,
@@ -103,6 +130,10 @@ mod tests {
                 &self.tables,
                 &mut self.stats,
             )
+        }
+
+        fn update(&mut self, rule: UpdateRule) -> bool {
+            self.change(rule).changed()
         }
 
         fn voxel(&self) -> Voxel {
@@ -153,6 +184,25 @@ mod tests {
         assert_eq!(p.stats.counts, [1, 0]);
         assert_eq!(p.stats.entropy[0], i64::from(p.tables.entry(-1992).entropy));
         assert_eq!(p.stats.entropy[1], 0);
+    }
+
+    #[test]
+    fn state_changes_are_told_apart_from_log_odds_changes() {
+        use VoxelChange::*;
+        let mut p = Probe::new(TABLES_MIN, TABLES_MAX);
+        // Unknown -> free (-405), free -> free (-810), then a hit crosses l = 0 (37).
+        assert_eq!(p.change(rule(1, -405)), State);
+        assert_eq!(p.change(rule(1, -405)), None, "same scan");
+        assert_eq!(p.change(rule(2, -405)), LogOdds);
+        assert_eq!(p.change(rule(3, 847)), State);
+        assert_eq!(p.voxel().log_odds, 37);
+        assert_eq!(p.change(rule(4, 847)), LogOdds, "884");
+        assert_eq!(p.change(rule(5, -405)), LogOdds, "479");
+        assert_eq!(p.change(rule(6, -405)), LogOdds, "74: still occupied");
+        assert_eq!(p.change(rule(7, -405)), State, "-331: free");
+        // Unknown -> occupied.
+        let mut q = Probe::new(TABLES_MIN, TABLES_MAX);
+        assert_eq!(q.change(rule(1, 847)), State);
     }
 
     #[test]

@@ -15,6 +15,7 @@
 use super::search::SNAP_RADIUS_M;
 use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
+use crate::mapping::OccupancyMap;
 use glam::DVec3;
 use uavex_components::trajectory::{PiecewisePolynomial, Trajectory};
 
@@ -78,6 +79,20 @@ pub fn polynomial_position(trajectory: &PiecewisePolynomial, t: f64) -> DVec3 {
     )
 }
 
+/// The sample times of the checks: every `COLLISION_SAMPLE_SPACING_M / max_speed` from `t0`
+/// (clamped to `0..=end`) to `end`, both included; `None` for non-positive or non-finite
+/// `max_speed` or times.
+fn sample_times(end: f64, t0: f64, max_speed: f64) -> Option<impl Iterator<Item = f64>> {
+    let valid = max_speed.is_finite() && max_speed > 0.0 && t0.is_finite() && end.is_finite();
+    if !valid {
+        return None;
+    }
+    let step = COLLISION_SAMPLE_SPACING_M / max_speed;
+    let t0 = t0.clamp(0.0, end);
+    let samples = ((end - t0) / step).ceil() as u64;
+    Some((0..=samples).map(move |i| (t0 + i as f64 * step).min(end)))
+}
+
 /// The sampling loop of [`first_untraversable`] over any position function of time.
 fn scan(
     grid: &TraversableGrid,
@@ -86,17 +101,12 @@ fn scan(
     t0: f64,
     max_speed: f64,
 ) -> Option<(f64, DVec3)> {
-    let valid = max_speed.is_finite() && max_speed > 0.0 && t0.is_finite() && end.is_finite();
-    if !valid {
+    let Some(times) = sample_times(end, t0, max_speed) else {
         return Some((t0, position(0.0)));
-    }
-    let step = COLLISION_SAMPLE_SPACING_M / max_speed;
-    let t0 = t0.clamp(0.0, end);
-    let samples = ((end - t0) / step).ceil() as u64;
-    let origin = position(t0);
+    };
+    let origin = position(t0.clamp(0.0, end));
     let mut escaping = !grid.is_traversable_point(origin);
-    for i in 0..=samples {
-        let t = (t0 + i as f64 * step).min(end);
+    for t in times {
         let p = position(t);
         if grid.is_traversable_point(p) {
             escaping = false;
@@ -105,6 +115,25 @@ fn scan(
         }
     }
     None
+}
+
+/// Brings the grid up to date where [`remains_traversable`] will look along `trajectory`
+/// from `t0` (the chunks under its samples), leaving the rest of the grid's dirty chunks for
+/// the next full [`TraversableGrid::refresh`]: a periodic check of the flown trajectory need
+/// not pay for the whole map's changes.
+pub fn refresh_along(
+    grid: &mut TraversableGrid,
+    map: &impl OccupancyMap,
+    trajectory: &dyn Trajectory,
+    t0: f64,
+    max_speed: f64,
+) {
+    let end = trajectory.duration();
+    let origin = trajectory.sample(t0.clamp(0.0, end.max(0.0))).position;
+    grid.refresh_at(map, origin);
+    for t in sample_times(end, t0, max_speed).into_iter().flatten() {
+        grid.refresh_at(map, trajectory.sample(t).position);
+    }
 }
 
 /// Whether the rest of `trajectory` from `t0` is still traversable on the latest grid (the

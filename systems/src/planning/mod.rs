@@ -28,34 +28,37 @@ mod tests;
 mod tests_planner;
 
 pub use check::{
-    first_untraversable, first_untraversable_polynomial, polynomial_position, remains_traversable,
+    first_untraversable, first_untraversable_polynomial, polynomial_position, refresh_along,
+    remains_traversable,
 };
 pub use global::{GlobalPlan, plan_along, plan_global};
 pub use local::{LocalPlan, plan_local};
 pub use search::{SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
 pub use traversable::TraversableGrid;
 
+use crate::mapping::StateChanges;
 use bevy_ecs::prelude::*;
-use uavex_components::map::{ChunkCoord, VoxelChunk};
+use uavex_components::map::ChunkCoord;
 
 /// The traversability grid of the shared map, as a resource.
 #[derive(Resource, Debug, Clone)]
 pub struct Traversability(pub TraversableGrid);
 
-/// Frontier stage: marks every map chunk changed since this system last ran (and the chunks
-/// its inflation reaches) dirty in the [`Traversability`] grid. Does nothing while the
-/// resource is absent (runs that do not plan on the map).
+/// Frontier stage: marks every map chunk whose voxel states changed since this system last ran
+/// (and the chunks its inflation reaches) dirty in the [`Traversability`] grid: traversability
+/// depends on states alone. Does nothing while the resource is absent (runs that do not plan on
+/// the map).
 pub fn track_traversability(
     grid: Option<ResMut<Traversability>>,
-    changed: Query<&ChunkCoord, Changed<VoxelChunk>>,
+    mut changes: StateChanges,
+    mut scratch: Local<Vec<ChunkCoord>>,
 ) {
     let Some(mut grid) = grid else {
         return;
     };
-    if changed.is_empty() {
-        return;
-    }
-    for coord in &changed {
+    scratch.clear();
+    changes.collect_into(&mut scratch);
+    for coord in scratch.iter() {
         grid.0.mark_changed(*coord);
     }
 }

@@ -304,3 +304,51 @@ fn planning_succeeds_on_random_maps_whenever_a_path_exists() {
     assert!(paths >= 30, "{paths}");
     assert_eq!((global, local), (paths, paths));
 }
+
+/// A check refreshed only along the trajectory ([`refresh_along`]) answers as one on a fully
+/// refreshed grid, and leaves chunks away from the trajectory dirty.
+#[test]
+fn a_check_refreshed_along_the_trajectory_equals_one_on_the_full_grid() {
+    let mut map = wall_room();
+    let mut grid = map.grid(0.27);
+    let limits = kingfisher();
+    let start = TrajectoryPoint::at_rest(DVec3::new(1.1, 1.1, 0.7), 0.0);
+    let plan = plan_global(&grid, &start, DVec3::new(5.1, 1.1, 0.7), None, &limits).unwrap();
+    let t0 = 0.5;
+    // Two changes: an obstacle on the trajectory's way, one far from it (y = 6 m).
+    let on_path = plan
+        .trajectory
+        .sample(plan.trajectory.duration() * 0.6)
+        .position;
+    let key = (on_path / 0.1).floor().as_ivec3();
+    map.fill(key - IVec3::ONE, key + IVec3::ONE, OCCUPIED);
+    map.fill(IVec3::new(10, 60, 5), IVec3::new(11, 61, 6), OCCUPIED);
+    for coord in map.store.take_written() {
+        grid.mark_changed(coord);
+    }
+    let mut partial = grid.clone();
+    refresh_along(
+        &mut partial,
+        &map.store,
+        &plan.trajectory,
+        t0,
+        limits.max_velocity,
+    );
+    grid.refresh(&map.store);
+    let check =
+        |g: &TraversableGrid| first_untraversable(g, &plan.trajectory, t0, limits.max_velocity);
+    assert!(check(&grid).is_some(), "the obstacle blocks the trajectory");
+    assert_eq!(check(&partial), check(&grid));
+    assert!(partial.dirty_chunks() > 0, "the far chunks are left dirty");
+    // A full refresh afterwards catches up with the rest.
+    partial.refresh(&map.store);
+    assert_eq!(partial.dirty_chunks(), 0);
+    for z in 0..16 {
+        for y in 0..64 {
+            for x in 0..64 {
+                let k = IVec3::new(x, y, z);
+                assert_eq!(partial.is_traversable(k), grid.is_traversable(k), "{k}");
+            }
+        }
+    }
+}

@@ -195,7 +195,7 @@ impl TraversableGrid {
 
     /// Number of chunks waiting for a refresh.
     pub fn dirty_chunks(&self) -> usize {
-        self.dirty.len()
+        self.dirty_flags.iter().filter(|&&dirty| dirty).count()
     }
 
     fn mark_flat(&mut self, flat: usize) {
@@ -205,21 +205,47 @@ impl TraversableGrid {
         }
     }
 
-    /// Recomputes the dirty chunks from `map`. A map of another geometry (e.g. after a change
-    /// of resolution) rebuilds the grid from scratch for it, with the same inflation radius.
+    /// Recomputes the dirty chunks from `map` (see [`Self::follow_geometry`] for a map of
+    /// another geometry).
     pub fn refresh(&mut self, map: &impl OccupancyMap) {
+        self.follow_geometry(map);
+        let mut dirty = std::mem::take(&mut self.dirty);
+        dirty.sort_unstable();
+        for &flat in &dirty {
+            // Chunks brought up to date one by one since they were marked are skipped.
+            if std::mem::take(&mut self.dirty_flags[flat]) {
+                self.refresh_chunk(map, flat);
+            }
+        }
+        dirty.clear();
+        self.dirty = dirty;
+    }
+
+    /// Recomputes the chunk holding `p` if it is dirty, so that queries of the voxels of that
+    /// chunk are up to date (a chunk's traversability reads the map only, never its
+    /// neighbours' traversability). Points outside the map or not finite are ignored.
+    pub fn refresh_at(&mut self, map: &impl OccupancyMap, p: DVec3) {
+        self.follow_geometry(map);
+        if !p.is_finite() {
+            return;
+        }
+        let key = self.key_of(p);
+        if key.cmplt(self.key_min).any() || key.cmpgt(self.key_max).any() {
+            return;
+        }
+        let flat = self.chunk_grid.flat_unchecked(ChunkCoord::of_key(key));
+        if std::mem::take(&mut self.dirty_flags[flat]) {
+            self.refresh_chunk(map, flat);
+        }
+    }
+
+    /// A map of another geometry (e.g. after a change of resolution) rebuilds the grid from
+    /// scratch for it, with the same inflation radius, every chunk dirty.
+    fn follow_geometry(&mut self, map: &impl OccupancyMap) {
         if !self.matches(map.config()) {
             *self = Self::new(map.config(), self.inflation_m);
             self.mark_all();
         }
-        let mut dirty = std::mem::take(&mut self.dirty);
-        dirty.sort_unstable();
-        for &flat in &dirty {
-            self.dirty_flags[flat] = false;
-            self.refresh_chunk(map, flat);
-        }
-        dirty.clear();
-        self.dirty = dirty;
     }
 
     /// Whether voxel `key` is traversable (false outside the map).

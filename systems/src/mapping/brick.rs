@@ -32,7 +32,7 @@ impl SaturatedStretch {
 }
 
 /// The axis whose next crossing comes first, ties to x, then y, then z (the walk's rule).
-#[inline(always)]
+#[cfg(test)]
 fn first(times: [i64; 3]) -> usize {
     if times[0] <= times[1] && times[0] <= times[2] {
         0
@@ -40,6 +40,42 @@ fn first(times: [i64; 3]) -> usize {
         1
     } else {
         2
+    }
+}
+
+/// All ones if `c`, else zero.
+#[inline(always)]
+fn mask(c: bool) -> i64 {
+    -i64::from(c)
+}
+
+/// Brick coordinates of the chunk packed one per byte, each plus 4 (so 4..=7 inside the chunk,
+/// 3 or 8 just outside): one add moves along an axis, one mask test tells leaving the chunk.
+#[derive(Clone, Copy)]
+struct BrickCursor(i32);
+
+impl BrickCursor {
+    const BIAS: i32 = 0x0004_0404;
+    const OUTSIDE_BITS: i32 = 0x00FC_FCFC;
+
+    fn at(brick: [i64; 3]) -> Self {
+        Self(Self::BIAS + (brick[0] | brick[1] << 8 | brick[2] << 16) as i32)
+    }
+
+    #[inline(always)]
+    fn inside(self) -> bool {
+        self.0 & Self::OUTSIDE_BITS == Self::BIAS
+    }
+
+    /// Index of the brick in the chunk (x fastest), while inside.
+    #[inline(always)]
+    fn index(self) -> usize {
+        let c = self.0 as usize;
+        (c & 3) | (c >> 6 & 0xC) | (c >> 12 & 0x30)
+    }
+
+    fn coordinate(self, axis: usize) -> i64 {
+        i64::from((self.0 >> (8 * axis)) & 0xFF) - 4
     }
 }
 
@@ -57,6 +93,9 @@ fn first(times: [i64; 3]) -> usize {
 /// axis `b` has taken every crossing ordered before that one: all before its next face `T_b`
 /// except those of `T_b - dt_b`, `T_b - 2 dt_b`, `T_b - 3 dt_b` still ahead of the walk that
 /// come at or after `T` (or strictly after, when `b` loses ties to `e`).
+///
+/// The brick loop is the voxel walk's own loop one level up: face times in registers, the axis
+/// chosen with compares and masks (a branch on it is mispredicted every other brick).
 // Not inlined: the voxel loop that calls it keeps its state in registers.
 #[inline(never)]
 pub fn walk_saturated(
@@ -67,63 +106,98 @@ pub fn walk_saturated(
     t_limit: i64,
     saturated: &[u8; CHUNK_BRICKS],
 ) -> Option<SaturatedStretch> {
+    // Per axis, by hand rather than over arrays: arrays indexed by axis, and the closures of
+    // `array::map`, made this function several times longer than its arithmetic.
+    let [ax, ay, az] = [
+        ahead(local[0], steps[0]),
+        ahead(local[1], steps[1]),
+        ahead(local[2], steps[2]),
+    ];
+    let [dtx, dty, dtz] = dt;
+    // Time of the face ahead on each axis, and the interval between faces.
+    let (mut fx, mut fy, mut fz) = (
+        t[0] + (ax - 1) * dtx,
+        t[1] + (ay - 1) * dty,
+        t[2] + (az - 1) * dtz,
+    );
     let edge = i64::from(BRICK_EDGE);
-    let mut brick = local.map(|l| l / edge);
-    // Crossing index (from now) and time of the next brick face on each axis.
-    let mut index = [0; 3];
-    let mut face = [0; 3];
-    for a in 0..3 {
-        let within = local[a] % edge;
-        let n = if steps[a] > 0 {
-            edge - within
-        } else {
-            within + 1
-        };
-        index[a] = n - 1;
-        face[a] = t[a] + (n - 1) * dt[a];
-    }
-    // The last face crossed: its time, axis and crossing index.
-    let mut last = None;
+    let (dx, dy, dz) = (edge * dtx, edge * dty, edge * dtz);
+    let start = BrickCursor::at([local[0] >> 2, local[1] >> 2, local[2] >> 2]);
+    let (sx, sy, sz) = (steps[0], steps[1] << 8, steps[2] << 16);
+    let mut cursor = start;
+    // The axis of the last face crossed, as masks (all zero: none yet).
+    let (mut lx, mut ly, mut lz) = (0i64, 0i64, 0i64);
     loop {
-        let e = first(face);
-        let time = face[e];
-        if time >= t_limit {
+        let x = mask((fx <= fy) & (fx <= fz));
+        let y = !x & mask(fy <= fz);
+        let z = !x & !y;
+        if (x & fx) | (y & fy) | (z & fz) >= t_limit {
             break;
         }
-        last = Some((time, e, index[e]));
-        face[e] += edge * dt[e];
-        index[e] += edge;
-        brick[e] += steps[e];
-        let in_chunk = brick.iter().all(|&b| (0..edge).contains(&b));
-        if !in_chunk
-            || saturated[(brick[0] + edge * (brick[1] + edge * brick[2])) as usize] != BRICK_VOXELS
-        {
+        (lx, ly, lz) = (x, y, z);
+        fx += x & dx;
+        fy += y & dy;
+        fz += z & dz;
+        cursor.0 = cursor
+            .0
+            .wrapping_add(((x & sx) | (y & sy) | (z & sz)) as i32);
+        if !cursor.inside() || saturated[cursor.index()] != BRICK_VOXELS {
             break;
         }
     }
-    let (time, e, crossed) = last?;
-    let mut stretch = SaturatedStretch {
-        crossings: [0; 3],
-        boundary_times: t,
+    if lx | ly | lz == 0 {
+        return None;
+    }
+    // The last face crossed (on axis e) came at `time`; the crossing index (from now) of the
+    // next face on each axis follows from the bricks crossed on it.
+    let time = (lx & (fx - dx)) | (ly & (fy - dy)) | (lz & (fz - dz));
+    let index = |axis: usize, ahead: i64| {
+        ahead - 1 + edge * (cursor.coordinate(axis) - start.coordinate(axis)).abs()
     };
-    for b in 0..3 {
-        let (k, next) = if b == e {
-            (crossed + 1, time + dt[b])
-        } else if dt[b] == 0 {
-            (0, t[b])
-        } else {
-            // Only crossings from now on count (`m <= index`): one before the start may tie
-            // with `T` at time 0 (a walk starting on a face), and is not the stretch's to take.
-            let before = time + i64::from(b < e);
-            let pending: i64 = (1..edge)
-                .map(|m| i64::from(m <= index[b] && face[b] - m * dt[b] >= before))
-                .sum();
-            (index[b] - pending, face[b] - pending * dt[b])
-        };
-        stretch.crossings[b] = k;
-        stretch.boundary_times[b] = next;
+    let (ix, iy, iz) = (index(0, ax), index(1, ay), index(2, az));
+    // Axis e took its crossing at `time`; each other axis b the ones ordered before it, that
+    // is before `time`, or at it too when b wins ties against e (b < e).
+    let x = settle(fx, dtx, ix, time + i64::from(ly | lz != 0), lx);
+    let y = settle(fy, dty, iy, time + i64::from(lz != 0), ly);
+    let z = settle(fz, dtz, iz, time, lz);
+    Some(SaturatedStretch {
+        crossings: [x.0, y.0, z.0],
+        boundary_times: [x.1, y.1, z.1],
+    })
+}
+
+/// Crossings of an axis from chunk-local coordinate `local` with step `step` up to and
+/// including the one onto the face of its brick ahead.
+#[inline(always)]
+fn ahead(local: i64, step: i64) -> i64 {
+    let within = local & (i64::from(BRICK_EDGE) - 1);
+    if step > 0 {
+        i64::from(BRICK_EDGE) - within
+    } else {
+        within + 1
     }
-    Some(stretch)
+}
+
+/// Crossings taken and next boundary time of one axis at the end of a stretch: `face` is the
+/// time of its next face, `index` that face's crossing index from the start, `dt` the interval.
+/// For the axis of the last face crossed (`last` all ones), the crossing just before `face`
+/// was that one; for the others, the crossings of the last brick (up to three before `face`)
+/// at or after `before` are still ahead. (An axis that does not move has `face` = `i64::MAX`,
+/// `dt` = 0 and `index` < 4: no crossings, time unchanged.)
+#[inline(always)]
+fn settle(face: i64, dt: i64, index: i64, before: i64, last: i64) -> (i64, i64) {
+    let edge = i64::from(BRICK_EDGE);
+    // Only crossings from now on count (`m <= index`): one before the start may tie with the
+    // last face at time 0 (a walk starting on a face), and is not the stretch's to take.
+    let pending = i64::from((index >= 1) & (face - dt >= before))
+        + i64::from((index >= 2) & (face - 2 * dt >= before))
+        + i64::from((index >= 3) & (face - 3 * dt >= before));
+    let (k, next) = (index - pending, face - pending * dt);
+    let (k_last, next_last) = (index - edge + 1, face - (edge - 1) * dt);
+    (
+        (last & k_last) | (!last & k),
+        (last & next_last) | (!last & next),
+    )
 }
 
 #[cfg(test)]

@@ -393,7 +393,8 @@ impl Cursor {
     /// Local coordinates inside the chunk (0..16 per axis, while inside).
     #[inline(always)]
     fn local_array(self) -> [i64; 3] {
-        [32, 40, 48].map(|shift| ((self.0 >> shift) & 0xFF) as i64 - i64::from(CHUNK_EDGE))
+        let byte = |shift: u64| ((self.0 >> shift) & 0xFF) as i64 - i64::from(CHUNK_EDGE);
+        [byte(32), byte(40), byte(48)]
     }
 
     /// Local coordinates (-1 or 16 on the axis just stepped out of the chunk).

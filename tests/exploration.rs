@@ -7,12 +7,12 @@ mod common;
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
-use uavex::components::exploration::{Chosen, DecisionLog, GoalKind, GoalOutcome};
+use uavex::components::exploration::{CandidateScope, Chosen, DecisionLog, GoalKind, GoalOutcome};
 use uavex::components::map::MapConfig;
 use uavex::components::sim::Outcome;
 use uavex::components::world::WorldGeometry;
 use uavex::engine::exploration::{
-    BudgetSpec, CandidateCount, ExploreSpec, StrategyName, decisions_csv,
+    BudgetSpec, CandidateCount, Evaluate, ExploreSpec, StrategyName, decisions_csv,
 };
 use uavex::engine::output::RunSummary;
 use uavex::engine::reachable::ReachableVolume;
@@ -32,6 +32,7 @@ fn scene(file: &str, strategy: StrategyName) -> LoadedScenario {
     loaded.scenario.uavs[0].behaviour = BehaviourSpec::Explore(ExploreSpec {
         strategy,
         candidates: CandidateCount::Count(3),
+        evaluate: Evaluate::Needed,
         unified: false,
         replan_hz: 2.0,
         energy_budget: None,
@@ -231,10 +232,12 @@ fn a_new_strategy_is_one_system() {
         .query_filtered::<Entity, With<ClassicStrategy>>()
         .single(&sim.world)
         .unwrap();
+    // The marker, and which clusters its choice needs evaluated: all of them (the default of
+    // a UAV without a scope; Classic's scope, the largest feasible one, would not do).
     sim.world
         .entity_mut(uav)
         .remove::<ClassicStrategy>()
-        .insert(SmallestGain);
+        .insert((SmallestGain, CandidateScope::All));
     sim.add_systems(choose_smallest_gain.in_set(DecideStep::Choose));
     sim.run_to_end();
     let log = sim.world.resource::<DecisionLog>();

@@ -79,6 +79,35 @@ pub struct Explorer {
     pub start_clear_radius: f64,
 }
 
+/// Which clusters a decision plans and rolls out (eaae.md steps 6-7), a component of the UAV
+/// set with its strategy; absent means [`CandidateScope::All`].
+///
+/// Planning a trajectory and rolling it out is most of a decision's cost, and a strategy that
+/// looks only at the first clusters of some order (EAAE: the N of largest IG; Classic: the
+/// largest; Nearest: the closest) needs only those that are choosable (feasible, and
+/// affordable under an energy budget): `Ranked` evaluates clusters in that order until it has
+/// `needed` of them, and the pick is the one evaluating every cluster would give (ties are
+/// kept in the clusters' order either way). `All` evaluates every cluster, so that the decision
+/// log prices every option (and any strategy may choose among them).
+#[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum CandidateScope {
+    #[default]
+    All,
+    Ranked {
+        by: Ranking,
+        needed: usize,
+    },
+}
+
+/// An order of clusters for [`CandidateScope::Ranked`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ranking {
+    /// Largest information gain first.
+    InformationGain,
+    /// Nearest centroid first (straight-line distance from the UAV).
+    Distance,
+}
+
 /// Marker: the UAV needs a new goal; the Decide stage makes one this tick.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct NeedsDecision;

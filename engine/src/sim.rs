@@ -2,7 +2,7 @@
 //! `Tick` schedule with the pipeline stages (DESIGN.md "One tick").
 
 use crate::exploration::setup::camera_of;
-use crate::exploration::{add_exploration, explorer_components};
+use crate::exploration::{Evaluate, add_exploration, explorer_components};
 use crate::flight::{Physics, airframe_of, end_on_empty_battery, step_physics, waypoint_flight};
 use crate::metrics::{RunRecord, record_metrics};
 use crate::scenario::{BehaviourSpec, LoadedScenario, ScenarioErrors};
@@ -172,7 +172,7 @@ impl Sim {
                         Ok((bundle, strategy)) => {
                             let mut entity = world.entity_mut(uav);
                             entity.insert(bundle);
-                            strategy.insert(&mut entity);
+                            strategy.insert(&mut entity, explore.evaluate == Evaluate::All);
                             if let Some(camera) = camera_of(spec) {
                                 exploration
                                     .get_or_insert_with(|| (camera, Vec::new()))

@@ -9,4 +9,4 @@ pub mod spec;
 
 pub use log::{ExplorationSummary, decision_timings_csv, decisions_csv};
 pub use setup::{add_exploration, explorer_components};
-pub use spec::{AllCandidates, BudgetSpec, CandidateCount, ExploreSpec, StrategyName};
+pub use spec::{AllCandidates, BudgetSpec, CandidateCount, Evaluate, ExploreSpec, StrategyName};

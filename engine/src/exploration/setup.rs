@@ -10,7 +10,9 @@ use bevy_ecs::prelude::*;
 use glam::DVec3;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
-use uavex_components::exploration::{EnergyBudget, Explorer, ExplorerSettings, NeedsDecision};
+use uavex_components::exploration::{
+    CandidateScope, EnergyBudget, Explorer, ExplorerSettings, NeedsDecision,
+};
 use uavex_components::frontier::ClusterSettings;
 use uavex_components::map::MapConfig;
 use uavex_components::trajectory::Hold;
@@ -178,12 +180,28 @@ pub enum StrategyMarker {
 }
 
 impl StrategyMarker {
-    pub fn insert(self, entity: &mut EntityWorldMut) {
-        match self {
-            StrategyMarker::Eaae(s) => entity.insert(s),
-            StrategyMarker::Classic => entity.insert(ClassicStrategy),
-            StrategyMarker::Nearest => entity.insert(NearestStrategy),
+    /// Inserts the marker and the candidate scope its choice needs (every cluster when
+    /// `evaluate_all`).
+    pub fn insert(self, entity: &mut EntityWorldMut, evaluate_all: bool) {
+        let scope = match self {
+            StrategyMarker::Eaae(s) => {
+                entity.insert(s);
+                s.scope()
+            }
+            StrategyMarker::Classic => {
+                entity.insert(ClassicStrategy);
+                ClassicStrategy.scope()
+            }
+            StrategyMarker::Nearest => {
+                entity.insert(NearestStrategy);
+                NearestStrategy.scope()
+            }
         };
+        entity.insert(if evaluate_all {
+            CandidateScope::All
+        } else {
+            scope
+        });
     }
 }
 

@@ -6,6 +6,8 @@
 //! kind = "explore"
 //! strategy = "eaae"          # or "classic" (largest frontier), "nearest" (nearest frontier)
 //! candidates = 3             # EAAE: clusters of largest IG weighed by energy; or "all"
+//! evaluate = "needed"        # plan and roll out only the clusters the choice needs; "all":
+//!                            # every cluster (the decision log then prices every option)
 //! unified = false            # fly the evaluated candidate itself while it stays free
 //! replan_hz = 2.0            # local planner's regular replanning rate
 //! energy_budget = { reserve_j = 5000.0 }   # optional: return home before the battery runs low
@@ -50,6 +52,18 @@ impl CandidateCount {
     }
 }
 
+/// Which clusters a decision plans and rolls out (`uavex_components::exploration::CandidateScope`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Evaluate {
+    /// Those the strategy's choice needs (EAAE: its `candidates` of largest IG that are
+    /// feasible; the baselines: the first feasible one in their order): the same pick, less work.
+    #[default]
+    Needed,
+    /// Every cluster, so that the decision log holds the predicted energy of every option.
+    All,
+}
+
 /// The energy budget: keep this much in reserve beyond the predicted flight home.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -62,9 +76,11 @@ pub struct BudgetSpec {
 #[serde(deny_unknown_fields)]
 pub struct ExploreSpec {
     pub strategy: StrategyName,
-    /// EAAE's N (the thesis: 3); ignored by the baselines, which choose among all.
+    /// EAAE's N (the thesis: 3); ignored by the baselines, which choose among all feasible.
     #[serde(default = "default_candidates")]
     pub candidates: CandidateCount,
+    #[serde(default)]
+    pub evaluate: Evaluate,
     #[serde(default)]
     pub unified: bool,
     #[serde(default = "default_replan_hz")]

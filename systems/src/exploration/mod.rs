@@ -3,9 +3,10 @@
 //!
 //! One decision is a chain of small systems in the Decide stage ([`DecideStep`]):
 //! 1. `Cluster`: frontier clusters as entities (`crate::frontier::refresh_clusters`);
-//! 2. `Propose`: [`propose::propose_candidates`] plans a trajectory to every reachable cluster
-//!    (one multi-goal search, then minimum-snap per cluster, in parallel) and rolls each out
-//!    through the quadrotor model (energy, duration), as candidate entities;
+//! 2. `Propose`: [`propose::propose_candidates`] plans a trajectory to the reachable clusters
+//!    the strategy needs ([`evaluate`]: one multi-goal search, then minimum-snap per cluster, in
+//!    parallel) and rolls each out through the quadrotor model (energy, duration), as
+//!    candidate entities;
 //! 3. `Choose`: exactly one strategy system per UAV marks its pick with `Chosen`
 //!    ([`strategy`]: `eaae`, `classic`, `nearest`; a new strategy is a new system here);
 //! 4. `Commit`: [`commit::commit_decisions`] makes the pick the UAV's goal, logs the decision
@@ -16,6 +17,7 @@
 
 pub mod budget;
 pub mod commit;
+pub mod evaluate;
 pub mod execute;
 pub mod propose;
 pub mod strategy;

@@ -1,31 +1,34 @@
-//! Candidates (eaae.md steps 5-7): a trajectory to every reachable frontier cluster, each rolled
-//! out through the quadrotor model for its energy and duration.
+//! Candidates (eaae.md steps 5-7): a trajectory to the reachable frontier clusters the UAV's
+//! strategy needs (its `CandidateScope`, see [`super::evaluate`]), each rolled out through the
+//! quadrotor model for its energy and duration, as candidate entities.
 //!
 //! The published system planned each of its three candidates with its own kinodynamic search
 //! (1.9-3.3 s per decision). Here one multi-goal search from the UAV reaches every cluster's
 //! centroid and viewpoints at once; each cluster then gets its minimum-snap trajectory (centroid
 //! first, then viewpoints in turn, eaae.md step 6) and its rollout, clusters in parallel
-//! (rayon), results in cluster order so that the decision is the same on any thread count.
+//! (rayon), results in a fixed order so that the decision is the same on any thread count.
 
-use super::budget::{ReturnHome, return_energies};
+use super::budget::ReturnHome;
+use super::evaluate::{
+    BudgetCheck, DecisionInputs, Evaluation, TargetPaths, evaluate, plan_targets,
+};
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
 use crate::flight::{Completion, FlightState, RolloutConfig, RolloutResult, rollout};
 use crate::mapping::MapReader;
-use crate::planning::{GlobalPlan, Traversability, TraversableGrid, find_paths, plan_along};
+use crate::planning::{GlobalPlan, Traversability, TraversableGrid};
 use crate::trajectory::DynamicLimits;
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
 use std::sync::Arc;
-use std::time::Instant;
 use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{
-    CandidateTrajectory, DecisionTiming, Explorer, For, NeedsDecision, PredictedDuration,
-    PredictedEnergy, Toward, Unaffordable,
+    CandidateScope, CandidateTrajectory, DecisionTiming, Explorer, For, NeedsDecision,
+    PredictedDuration, PredictedEnergy, Toward, Unaffordable,
 };
 use uavex_components::frontier::{FrontierCluster, Reachable, Viewpoint, Viewpoints};
 use uavex_components::sim::SimClock;
-use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
+use uavex_components::trajectory::TrajectoryPoint;
 use uavex_components::uav::QuadState;
 
 /// Longest search (voxel expansions) of one decision: a few times the voxels of the largest
@@ -53,10 +56,8 @@ pub struct PlannedCandidate {
     pub viewpoint: Option<usize>,
 }
 
-/// Eaae.md step 6 for every target: the trajectory to its centroid, or failing that to each of
-/// its viewpoints in turn; targets without a feasible trajectory are left out. One search
-/// reaches every goal ([`find_paths`]); the trajectories are planned in parallel.
-/// Goals within `min_travel_m` of the start are skipped: flying there gains nothing.
+/// Eaae.md step 6 for every target (see [`plan_targets`]): one search reaches every goal,
+/// the trajectories are planned in parallel.
 pub fn plan_candidates(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -64,44 +65,9 @@ pub fn plan_candidates(
     limits: &DynamicLimits,
     min_travel_m: f64,
 ) -> Vec<PlannedCandidate> {
-    // Goals: for each target its centroid, then its viewpoints.
-    let mut goals = Vec::new();
-    let mut first_goal = Vec::with_capacity(targets.len());
-    for target in targets {
-        first_goal.push(goals.len());
-        goals.push(target.centroid.as_dvec3());
-        goals.extend(target.viewpoints.iter().map(|v| v.position.as_dvec3()));
-    }
-    let paths = find_paths(grid, start.position, &goals, MAX_EXPANSIONS);
-    targets
-        .par_iter()
-        .enumerate()
-        .filter_map(|(index, target)| {
-            let first = first_goal[index];
-            let options = std::iter::once((None, None)).chain(
-                target
-                    .viewpoints
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| (Some(i), Some(f64::from(v.yaw)))),
-            );
-            options.enumerate().find_map(|(k, (viewpoint, yaw))| {
-                let path = paths[first + k].as_ref()?;
-                if goals[first + k].distance(start.position) <= min_travel_m {
-                    return None;
-                }
-                let plan = plan_along(grid, start, path, yaw, limits).ok()?;
-                let end = plan.trajectory.sample(plan.trajectory.duration());
-                Some(PlannedCandidate {
-                    target: index,
-                    goal: end.position,
-                    goal_yaw: end.yaw,
-                    plan,
-                    viewpoint,
-                })
-            })
-        })
-        .collect()
+    let paths = TargetPaths::search(grid, start.position, targets);
+    let all: Vec<usize> = (0..targets.len()).collect();
+    plan_targets(grid, start, targets, &paths, &all, limits, min_travel_m)
 }
 
 /// Eaae.md step 7: the predicted energy and duration of every planned candidate, from the
@@ -131,11 +97,25 @@ pub fn planning_start(
     )
 }
 
-/// Eaae.md steps 3 (the too-close rule) and 6 for one UAV at `position`: the targets at least
-/// `min_distance` away (in the order given: the caller sorts them deterministically) and their
-/// planned candidates; when none of those is feasible, the too-close targets instead (rather
-/// than ending with frontier in reach). Returns the targets planned and the candidates, whose
-/// `target` indexes them.
+/// Eaae.md step 3's too-close rule: the targets at least `min_distance` from `position`, and
+/// the others (in the order given: the caller sorts them deterministically). Decisions plan
+/// the near ones only when none of the far ones has a feasible trajectory (rather than ending
+/// with frontier in reach).
+pub fn split_too_close(
+    clusters: &[ClusterTarget],
+    position: Vec3,
+    min_distance: f32,
+) -> (Vec<ClusterTarget>, Vec<ClusterTarget>) {
+    clusters
+        .iter()
+        .cloned()
+        .partition(|c| c.centroid.distance(position) >= min_distance)
+}
+
+/// Eaae.md steps 3 and 6 for one UAV at `position`, every cluster planned (the propose step
+/// with [`CandidateScope::All`], trajectories only): the far targets of [`split_too_close`]
+/// and their candidates, or the near ones if no far one is feasible. Returns the targets
+/// planned and the candidates, whose `target` indexes them.
 pub fn plan_decision(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -145,10 +125,7 @@ pub fn plan_decision(
     limits: &DynamicLimits,
     min_travel_m: f64,
 ) -> (Vec<ClusterTarget>, Vec<PlannedCandidate>) {
-    let (far, near): (Vec<ClusterTarget>, Vec<ClusterTarget>) = clusters
-        .iter()
-        .cloned()
-        .partition(|c| c.centroid.distance(position) >= min_distance);
+    let (far, near) = split_too_close(clusters, position, min_distance);
     let planned = plan_candidates(grid, start, &far, limits, min_travel_m);
     if !planned.is_empty() || near.is_empty() {
         return (far, planned);
@@ -205,6 +182,7 @@ pub fn propose_candidates(
             &QuadState,
             Option<&ReferenceTrajectory>,
             Option<&FlightEnergy>,
+            Option<&CandidateScope>,
         ),
         With<NeedsDecision>,
     >,
@@ -216,57 +194,53 @@ pub fn propose_candidates(
     grid.0.refresh(&map);
     let all = cluster_targets(&clusters);
     let time_s = clock.time_s();
-    for (uav, explorer, airframe, state, reference, energy) in &uavs {
+    for (uav, explorer, airframe, state, reference, energy, scope) in &uavs {
         let settings = &explorer.settings;
         let limits = DynamicLimits::of(airframe);
         let start = planning_start(reference, state, time_s);
-        let flight_start = FlightState::from(state);
-        // The rollout ends a flight by the same rule the goal is judged by when flown.
-        let config = RolloutConfig {
-            completion: Completion {
-                position_tolerance: settings.goal_tolerance_m,
-                speed_tolerance: settings.goal_speed_tolerance,
-                ..Completion::default()
+        let inputs = DecisionInputs {
+            grid: &grid.0,
+            start,
+            flight: FlightState::from(state),
+            airframe,
+            limits,
+            // The rollout ends a flight by the same rule the goal is judged by when flown.
+            rollout: RolloutConfig {
+                completion: Completion {
+                    position_tolerance: settings.goal_tolerance_m,
+                    speed_tolerance: settings.goal_speed_tolerance,
+                    ..Completion::default()
+                },
+                ..RolloutConfig::default()
             },
-            ..RolloutConfig::default()
+            min_travel_m: settings.goal_tolerance_m,
+            budget: settings
+                .budget
+                .zip(energy)
+                .map(|(budget, energy)| BudgetCheck {
+                    left_j: energy.battery.usable_j - energy.battery.used_j - budget.reserve_j,
+                    home: explorer.home.as_dvec3(),
+                    home_yaw: f64::from(explorer.home_yaw),
+                }),
         };
-        let min_travel = settings.goal_tolerance_m;
+        let scope = scope.copied().unwrap_or_default();
 
-        let planning = Instant::now();
-        let (targets, planned) = plan_decision(
-            &grid.0,
-            &start,
-            &all,
-            state.position,
-            settings.min_goal_distance_m,
-            &limits,
-            min_travel,
-        );
-        let trajectory_ms = planning.elapsed().as_secs_f64() * 1e3;
-
-        let estimating = Instant::now();
-        let rollouts = roll_out_candidates(airframe, &flight_start, &planned, &config);
-        let mut returns = None;
-        if let (Some(budget), Some(energy)) = (settings.budget, energy) {
-            let left = energy.battery.usable_j - energy.battery.used_j - budget.reserve_j;
-            returns = Some((
-                left,
-                return_energies(
-                    &grid.0,
-                    airframe,
-                    explorer.home.as_dvec3(),
-                    f64::from(explorer.home_yaw),
-                    &planned,
-                    &limits,
-                    &config,
-                ),
-            ));
+        let (far, near) = split_too_close(&all, state.position, settings.min_goal_distance_m);
+        let mut evaluation = evaluate(&inputs, &far, state.position, scope);
+        let mut targets = far;
+        if evaluation.planned == 0 && !near.is_empty() {
+            let near_evaluation = evaluate(&inputs, &near, state.position, scope);
+            evaluation = Evaluation {
+                trajectory_ms: evaluation.trajectory_ms + near_evaluation.trajectory_ms,
+                energy_ms: evaluation.energy_ms + near_evaluation.energy_ms,
+                ..near_evaluation
+            };
+            targets = near;
         }
-        let energy_ms = estimating.elapsed().as_secs_f64() * 1e3;
 
         let mut any_affordable = false;
-        for (k, (candidate, result)) in planned.iter().zip(&rollouts).enumerate() {
-            let Some(result) = result else { continue };
+        for evaluated in &evaluation.candidates {
+            let (candidate, result) = (&evaluated.candidate, &evaluated.result);
             let target = &targets[candidate.target];
             let mut entity = commands.spawn((
                 CandidateTrajectory {
@@ -283,30 +257,27 @@ pub fn propose_candidates(
                 PredictedEnergy(result.energy_j),
                 PredictedDuration(result.duration_s),
             ));
-            match &returns {
-                Some((left, home)) => match home[k] {
-                    Some(back) if result.energy_j + back <= *left => any_affordable = true,
-                    back => {
-                        entity.insert(Unaffordable {
-                            return_energy_j: back.unwrap_or(f64::INFINITY),
-                        });
-                    }
-                },
-                None => any_affordable = true,
+            if evaluated.affordable(inputs.budget.as_ref()) {
+                any_affordable = true;
+            } else {
+                entity.insert(Unaffordable {
+                    return_energy_j: evaluated.return_j.flatten().unwrap_or(f64::INFINITY),
+                });
             }
         }
         // Home when there were goals but none affordable; with nothing left to explore the
         // mission is complete where it is.
-        let go_home = match (&returns, any_affordable) {
-            (Some(_), false) if !planned.is_empty() => super::budget::plan_home(
+        let go_home = match (&inputs.budget, any_affordable) {
+            (Some(budget), false) if evaluation.planned > 0 => super::budget::plan_home(
                 &grid.0,
-                &start,
-                explorer.home.as_dvec3(),
-                f64::from(explorer.home_yaw),
-                &limits,
+                &inputs.start,
+                budget.home,
+                budget.home_yaw,
+                &inputs.limits,
             ),
             _ => None,
         };
+        let (trajectory_ms, energy_ms) = (evaluation.trajectory_ms, evaluation.energy_ms);
         commands.entity(uav).insert(PendingDecision {
             clusters: targets.len(),
             timing: DecisionTiming {

@@ -3,11 +3,21 @@
 
 use super::{CandidateQuery, CandidateView, Deciding, choosable, first_min_by};
 use bevy_ecs::prelude::*;
-use uavex_components::exploration::Chosen;
+use uavex_components::exploration::{CandidateScope, Chosen, Ranking};
 
 /// Marker of a UAV that goes to the largest frontier cluster.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct ClassicStrategy;
+
+impl ClassicStrategy {
+    /// What the choice needs evaluated: the choosable cluster of largest IG.
+    pub fn scope(&self) -> CandidateScope {
+        CandidateScope::Ranked {
+            by: Ranking::InformationGain,
+            needed: 1,
+        }
+    }
+}
 
 /// The largest information gain (plain function).
 pub fn largest_gain(candidates: &[CandidateView]) -> Option<Entity> {

@@ -4,13 +4,27 @@
 
 use super::{CandidateQuery, CandidateView, choosable, first_min_by};
 use bevy_ecs::prelude::*;
-use uavex_components::exploration::{Candidates, Chosen, NeedsDecision};
+use uavex_components::exploration::{CandidateScope, Candidates, Chosen, NeedsDecision, Ranking};
 
 /// Marker of a UAV that explores with EAAE's choice.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq)]
 pub struct EaaeStrategy {
     /// How many candidates of largest IG are weighed by energy (`None`: all).
     pub shortlist: Option<usize>,
+}
+
+impl EaaeStrategy {
+    /// What the choice needs evaluated: the `shortlist` choosable clusters of largest IG, or
+    /// every cluster when all are weighed.
+    pub fn scope(&self) -> CandidateScope {
+        match self.shortlist {
+            Some(n) => CandidateScope::Ranked {
+                by: Ranking::InformationGain,
+                needed: n,
+            },
+            None => CandidateScope::All,
+        }
+    }
 }
 
 /// The EAAE choice among `candidates` (plain function).

@@ -3,11 +3,21 @@
 
 use super::{CandidateQuery, CandidateView, Deciding, choosable, first_min_by};
 use bevy_ecs::prelude::*;
-use uavex_components::exploration::Chosen;
+use uavex_components::exploration::{CandidateScope, Chosen, Ranking};
 
 /// Marker of a UAV that goes to the nearest frontier cluster.
 #[derive(Component, Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub struct NearestStrategy;
+
+impl NearestStrategy {
+    /// What the choice needs evaluated: the nearest choosable cluster.
+    pub fn scope(&self) -> CandidateScope {
+        CandidateScope::Ranked {
+            by: Ranking::Distance,
+            needed: 1,
+        }
+    }
+}
 
 /// The nearest centroid (plain function).
 pub fn nearest(candidates: &[CandidateView]) -> Option<Entity> {

@@ -1,0 +1,443 @@
+//! Evaluating frontier clusters for one decision (eaae.md steps 6-7) under the UAV's
+//! [`CandidateScope`]: a trajectory to each cluster (one multi-goal search, then a
+//! minimum-snap fit per cluster), its rollout through the quadrotor model, and under an energy
+//! budget its way home.
+//!
+//! `All` evaluates every cluster in one parallel batch. `Ranked` walks the clusters in the
+//! strategy's order ([`evaluation_order`]) in batches of `needed`, and stops once `needed`
+//! candidates are choosable (rolled out, and affordable under a budget). Every cluster's
+//! evaluation is independent of which others are evaluated (its path comes from the same
+//! search over every goal; its fit, rollout and way home are its own), so the first `needed`
+//! choosable clusters in the order are the ones an evaluation of all would rank first, and the
+//! strategy picks the same one.
+
+use super::budget::return_energies;
+use super::propose::{ClusterTarget, MAX_EXPANSIONS, PlannedCandidate};
+use crate::flight::{FlightState, RolloutConfig, RolloutResult, rollout};
+use crate::planning::{TraversableGrid, find_paths, plan_along};
+use crate::trajectory::DynamicLimits;
+use glam::{DVec3, Vec3};
+use rayon::prelude::*;
+use std::time::Instant;
+use uavex_components::airframe::Airframe;
+use uavex_components::exploration::{CandidateScope, Ranking};
+use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
+
+/// The paths of one multi-goal search from the UAV to every target's centroid and viewpoints.
+#[derive(Debug, Clone)]
+pub struct TargetPaths {
+    goals: Vec<DVec3>,
+    /// Index in `goals` of each target's centroid (its viewpoints follow).
+    first_goal: Vec<usize>,
+    paths: Vec<Option<Vec<DVec3>>>,
+}
+
+impl TargetPaths {
+    /// One search from `start` reaching every goal of `targets` ([`find_paths`]).
+    pub fn search(grid: &TraversableGrid, start: DVec3, targets: &[ClusterTarget]) -> Self {
+        let mut goals = Vec::new();
+        let mut first_goal = Vec::with_capacity(targets.len());
+        for target in targets {
+            first_goal.push(goals.len());
+            goals.push(target.centroid.as_dvec3());
+            goals.extend(target.viewpoints.iter().map(|v| v.position.as_dvec3()));
+        }
+        let paths = find_paths(grid, start, &goals, MAX_EXPANSIONS);
+        Self {
+            goals,
+            first_goal,
+            paths,
+        }
+    }
+}
+
+/// Eaae.md step 6 for the targets `which` (indices into `targets`, which `paths` was searched
+/// for), in parallel, results in the order of `which`: the trajectory to a target's centroid,
+/// or failing that to each of its viewpoints in turn; targets without a feasible trajectory
+/// are left out. Goals within `min_travel_m` of the start are skipped: flying there gains
+/// nothing.
+pub fn plan_targets(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
+    targets: &[ClusterTarget],
+    paths: &TargetPaths,
+    which: &[usize],
+    limits: &DynamicLimits,
+    min_travel_m: f64,
+) -> Vec<PlannedCandidate> {
+    which
+        .par_iter()
+        .filter_map(|&index| {
+            let target = &targets[index];
+            let first = paths.first_goal[index];
+            let options = std::iter::once((None, None)).chain(
+                target
+                    .viewpoints
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| (Some(i), Some(f64::from(v.yaw)))),
+            );
+            options.enumerate().find_map(|(k, (viewpoint, yaw))| {
+                let path = paths.paths[first + k].as_ref()?;
+                if paths.goals[first + k].distance(start.position) <= min_travel_m {
+                    return None;
+                }
+                let plan = plan_along(grid, start, path, yaw, limits).ok()?;
+                let end = plan.trajectory.sample(plan.trajectory.duration());
+                Some(PlannedCandidate {
+                    target: index,
+                    goal: end.position,
+                    goal_yaw: end.yaw,
+                    plan,
+                    viewpoint,
+                })
+            })
+        })
+        .collect()
+}
+
+/// The order in which `scope` evaluates `targets` (indices): as given for `All`; for `Ranked`,
+/// by the ranking, ties in the order given (the strategies break ties the same way).
+pub fn evaluation_order(
+    targets: &[ClusterTarget],
+    position: Vec3,
+    scope: CandidateScope,
+) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..targets.len()).collect();
+    match scope {
+        CandidateScope::All => {}
+        CandidateScope::Ranked {
+            by: Ranking::InformationGain,
+            ..
+        } => order.sort_by_key(|&i| std::cmp::Reverse(targets[i].size)),
+        CandidateScope::Ranked {
+            by: Ranking::Distance,
+            ..
+        } => order.sort_by(|&a, &b| {
+            let distance = |i: usize| targets[i].centroid.distance(position);
+            distance(a).total_cmp(&distance(b))
+        }),
+    }
+    order
+}
+
+/// Under an energy budget: what is left to spend (J) and where home is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BudgetCheck {
+    pub left_j: f64,
+    pub home: DVec3,
+    pub home_yaw: f64,
+}
+
+/// What one decision's evaluation starts from.
+#[derive(Debug, Clone)]
+pub struct DecisionInputs<'a> {
+    pub grid: &'a TraversableGrid,
+    /// Where trajectories start (the tracked reference now).
+    pub start: TrajectoryPoint,
+    /// Where rollouts start (the UAV's true state).
+    pub flight: FlightState,
+    pub airframe: &'a Airframe,
+    pub limits: DynamicLimits,
+    pub rollout: RolloutConfig,
+    pub min_travel_m: f64,
+    pub budget: Option<BudgetCheck>,
+}
+
+/// One evaluated candidate: its trajectory, the rollout's prediction, and under a budget the
+/// predicted energy home from its goal (`None` inside: no way home found).
+#[derive(Debug, Clone)]
+pub struct Evaluated {
+    pub candidate: PlannedCandidate,
+    pub result: RolloutResult,
+    pub return_j: Option<Option<f64>>,
+}
+
+impl Evaluated {
+    /// Whether the way there and back fits in what is left (always, without a budget).
+    pub fn affordable(&self, budget: Option<&BudgetCheck>) -> bool {
+        match (budget, self.return_j) {
+            (Some(budget), Some(back)) => {
+                back.is_some_and(|back| self.result.energy_j + back <= budget.left_j)
+            }
+            _ => true,
+        }
+    }
+}
+
+/// The evaluation of one group of targets.
+#[derive(Debug, Clone, Default)]
+pub struct Evaluation {
+    /// Rolled-out candidates, in evaluation order.
+    pub candidates: Vec<Evaluated>,
+    /// Candidates with a feasible trajectory (including those whose rollout failed).
+    pub planned: usize,
+    /// Wall-clock time (ms) spent on trajectories (search, fits) and on energy (rollouts,
+    /// ways home): EAAE Table 6.2's "trajectory generation" and "energy estimation".
+    pub trajectory_ms: f64,
+    pub energy_ms: f64,
+}
+
+/// Evaluates `targets` under `scope` (module documentation).
+pub fn evaluate(
+    inputs: &DecisionInputs<'_>,
+    targets: &[ClusterTarget],
+    position: Vec3,
+    scope: CandidateScope,
+) -> Evaluation {
+    let mut evaluation = Evaluation::default();
+    if targets.is_empty() {
+        return evaluation;
+    }
+    let searching = Instant::now();
+    let paths = TargetPaths::search(inputs.grid, inputs.start.position, targets);
+    evaluation.trajectory_ms += elapsed_ms(searching);
+    let order = evaluation_order(targets, position, scope);
+    let (batch, needed) = match scope {
+        CandidateScope::All => (order.len(), usize::MAX),
+        CandidateScope::Ranked { needed, .. } => (needed.max(1), needed.max(1)),
+    };
+    let mut choosable = 0;
+    for which in order.chunks(batch) {
+        let planning = Instant::now();
+        let planned = plan_targets(
+            inputs.grid,
+            &inputs.start,
+            targets,
+            &paths,
+            which,
+            &inputs.limits,
+            inputs.min_travel_m,
+        );
+        evaluation.trajectory_ms += elapsed_ms(planning);
+        evaluation.planned += planned.len();
+
+        let estimating = Instant::now();
+        let rollouts: Vec<Option<RolloutResult>> = planned
+            .par_iter()
+            .map(|c| {
+                rollout(
+                    inputs.airframe,
+                    &inputs.flight,
+                    &c.plan.trajectory,
+                    &inputs.rollout,
+                )
+                .ok()
+            })
+            .collect();
+        let returns = inputs.budget.map(|budget| {
+            return_energies(
+                inputs.grid,
+                inputs.airframe,
+                budget.home,
+                budget.home_yaw,
+                &planned,
+                &inputs.limits,
+                &inputs.rollout,
+            )
+        });
+        evaluation.energy_ms += elapsed_ms(estimating);
+
+        for (k, (candidate, result)) in planned.into_iter().zip(rollouts).enumerate() {
+            let Some(result) = result else { continue };
+            let evaluated = Evaluated {
+                candidate,
+                result,
+                return_j: returns.as_ref().map(|r| r[k]),
+            };
+            choosable += usize::from(evaluated.affordable(inputs.budget.as_ref()));
+            evaluation.candidates.push(evaluated);
+        }
+        if choosable >= needed {
+            break;
+        }
+    }
+    evaluation
+}
+
+fn elapsed_ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::exploration::strategy::classic::largest_gain;
+    use crate::exploration::strategy::eaae::least_energy_among_largest_gain;
+    use crate::exploration::strategy::nearest::nearest;
+    use crate::exploration::strategy::{
+        CandidateView, ClassicStrategy, EaaeStrategy, NearestStrategy,
+    };
+    use crate::mapping::{ChunkAccess, ChunkStore};
+    use bevy_ecs::entity::Entity;
+    use glam::IVec3;
+    use uavex_components::map::{ChunkCoord, MapConfig, MapSettings, local_index};
+
+    /// A 6.4 x 6.4 x 1.6 m room, known free, with a wall at x 3.0..3.2 m for y < 4 m and a
+    /// closed 1 m pocket (walls 0.2 m thick) from 4.6 to 6.0 m on x and y.
+    fn room() -> (MapConfig, ChunkStore, TraversableGrid) {
+        let config = MapConfig::new(&MapSettings {
+            resolution: 0.1,
+            bounds_min: DVec3::ZERO,
+            bounds_max: DVec3::new(6.4, 6.4, 1.6),
+            ..MapSettings::default()
+        })
+        .unwrap();
+        let mut store = ChunkStore::new(&config);
+        let (lo, hi) = (config.key_min(), config.key_max());
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                for x in lo.x..=hi.x {
+                    let key = IVec3::new(x, y, z);
+                    let pocket = |k: i32| (46..=47).contains(&k) || (58..=59).contains(&k);
+                    let around = |k: i32| (46..=59).contains(&k);
+                    let wall = (30..=31).contains(&x) && y < 40
+                        || around(x) && around(y) && (pocket(x) || pocket(y));
+                    let coord = ChunkCoord::of_key(key);
+                    let flat = config.chunk_grid().flat(coord).unwrap();
+                    store.chunk_mut(flat, coord).0.voxels_mut()[local_index(key)].log_odds =
+                        if wall { 3476 } else { -1992 };
+                }
+            }
+        }
+        let mut grid = TraversableGrid::new(&config, 0.27);
+        grid.mark_all();
+        grid.refresh(&store);
+        (config, store, grid)
+    }
+
+    /// Clusters all over the room (the largest in the closed pocket, out of reach), with gains
+    /// that tie in places.
+    fn targets() -> Vec<ClusterTarget> {
+        let spots = [
+            ([5.0, 1.0, 0.8], 120),
+            ([1.0, 5.5, 0.8], 300),
+            ([5.3, 5.3, 0.8], 500), // in the pocket
+            ([3.5, 5.5, 0.8], 300),
+            ([2.0, 3.0, 0.8], 80),
+            ([4.5, 3.0, 0.8], 200),
+            ([0.8, 0.8, 0.8], 150),
+        ];
+        spots
+            .iter()
+            .enumerate()
+            .map(|(i, &(c, size))| ClusterTarget {
+                entity: Entity::from_raw_u32(i as u32 + 1).unwrap(),
+                centroid: Vec3::from_array(c),
+                size,
+                viewpoints: Vec::new(),
+            })
+            .collect()
+    }
+
+    fn views(evaluation: &Evaluation, targets: &[ClusterTarget], at: Vec3) -> Vec<CandidateView> {
+        evaluation
+            .candidates
+            .iter()
+            .map(|e| {
+                let target = &targets[e.candidate.target];
+                CandidateView {
+                    entity: target.entity,
+                    information_gain: target.size,
+                    centroid_distance_m: target.centroid.distance(at),
+                    path_length_m: e.candidate.plan.path_length_m as f32,
+                    energy_j: e.result.energy_j,
+                    duration_s: e.result.duration_s,
+                }
+            })
+            .collect()
+    }
+
+    /// Each shipped strategy picks the same cluster from its ranked evaluation as from the
+    /// evaluation of every cluster, with fewer clusters evaluated.
+    #[test]
+    fn ranked_evaluation_picks_what_evaluating_all_would() {
+        let (_, _, grid) = room();
+        let airframe = Airframe::kingfisher();
+        let start = TrajectoryPoint::at_rest(DVec3::new(1.5, 1.5, 0.8), 0.0);
+        let at = start.position.as_vec3();
+        let inputs = DecisionInputs {
+            grid: &grid,
+            start,
+            flight: FlightState::hovering(&airframe, start.position, 0.0),
+            airframe: &airframe,
+            limits: DynamicLimits::of(&airframe),
+            rollout: RolloutConfig::default(),
+            min_travel_m: 0.3,
+            budget: None,
+        };
+        let targets = targets();
+        let all = evaluate(&inputs, &targets, at, CandidateScope::All);
+        assert_eq!(all.candidates.len(), 6, "all but the cluster in the pocket");
+        let every = views(&all, &targets, at);
+        type Choice = fn(&[CandidateView]) -> Option<Entity>;
+        let eaae3: Choice = |c| least_energy_among_largest_gain(c, Some(3));
+        let eaae1: Choice = |c| least_energy_among_largest_gain(c, Some(1));
+        let cases: [(CandidateScope, Choice, usize); 4] = [
+            (ClassicStrategy.scope(), largest_gain, 1),
+            (NearestStrategy.scope(), nearest, 1),
+            (EaaeStrategy { shortlist: Some(3) }.scope(), eaae3, 3),
+            (EaaeStrategy { shortlist: Some(1) }.scope(), eaae1, 1),
+        ];
+        for (scope, choose, needed) in cases {
+            let ranked = evaluate(&inputs, &targets, at, scope);
+            assert!(ranked.candidates.len() >= needed && ranked.candidates.len() < 6);
+            assert_eq!(
+                choose(&views(&ranked, &targets, at)),
+                choose(&every),
+                "{scope:?}"
+            );
+        }
+        // Classic skips the infeasible largest cluster (in the pocket) for the next: one of the
+        // two tied at 300, the first in the clusters' order.
+        assert_eq!(largest_gain(&every), Some(targets[1].entity));
+        // A budget that affords only short trips: the ranked evaluation goes on until it has
+        // an affordable one, and finds the same pick.
+        let tight = DecisionInputs {
+            budget: Some(BudgetCheck {
+                left_j: 900.0,
+                home: start.position,
+                home_yaw: 0.0,
+            }),
+            ..inputs.clone()
+        };
+        let all = evaluate(&tight, &targets, at, CandidateScope::All);
+        let affordable = |e: &Evaluation| -> Vec<CandidateView> {
+            let views = views(e, &targets, at);
+            e.candidates
+                .iter()
+                .zip(views)
+                .filter(|(c, _)| c.affordable(tight.budget.as_ref()))
+                .map(|(_, v)| v)
+                .collect()
+        };
+        let choosable_all = affordable(&all);
+        assert!(!choosable_all.is_empty() && choosable_all.len() < all.candidates.len());
+        let ranked = evaluate(&tight, &targets, at, ClassicStrategy.scope());
+        assert_eq!(
+            largest_gain(&affordable(&ranked)),
+            largest_gain(&choosable_all)
+        );
+    }
+
+    #[test]
+    fn the_orders_rank_by_gain_or_distance_and_keep_ties_in_order() {
+        let targets = targets();
+        let at = Vec3::new(1.5, 1.5, 0.8);
+        assert_eq!(
+            evaluation_order(&targets, at, CandidateScope::All),
+            vec![0, 1, 2, 3, 4, 5, 6]
+        );
+        assert_eq!(
+            evaluation_order(&targets, at, ClassicStrategy.scope()),
+            vec![2, 1, 3, 5, 6, 0, 4]
+        );
+        let by_distance = evaluation_order(&targets, at, NearestStrategy.scope());
+        assert_eq!(by_distance[0], 6, "(0.8, 0.8) is nearest to (1.5, 1.5)");
+        let d: Vec<f32> = by_distance
+            .iter()
+            .map(|&i| targets[i].centroid.distance(at))
+            .collect();
+        assert!(d.windows(2).all(|w| w[0] <= w[1]));
+    }
+}

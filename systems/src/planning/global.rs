@@ -59,7 +59,7 @@ pub fn plan_along(
     if original.len() < 2 {
         return Err(PlanError::NoWaypoints);
     }
-    let kept = shortcut_indices(grid, &original);
+    let kept = beyond_stopping(&shortcut_indices(grid, &original), &original, start, limits);
     let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
     let trajectory = fit(grid, start, &original, &kept, end_yaw, limits)?;
     Ok(GlobalPlan {
@@ -67,6 +67,34 @@ pub fn plan_along(
         path: shortened,
         trajectory,
     })
+}
+
+/// The kept path indices without the inner points within the stopping distance of a moving
+/// start (v^2 / 2 amax); the start (index 0) and the end stay.
+///
+/// Why: a moving start cannot turn on the spot, so a waypoint within its stopping distance
+/// pins the polynomial to a place it must overshoot to reach, and the overshoot grows the
+/// closer the waypoint is (in a Pillars mission one 1 cm behind a UAV at 2.5 m/s sent the
+/// polynomial 4 m on before it came back, and every fit of that decision failed, 1.5 s of
+/// planning). The fit puts path points back where the trajectory needs them.
+pub fn beyond_stopping(
+    kept: &[usize],
+    original: &[DVec3],
+    start: &TrajectoryPoint,
+    limits: &DynamicLimits,
+) -> Vec<usize> {
+    let speed = start.velocity.length();
+    let stopping_m = speed * speed / (2.0 * limits.max_acceleration);
+    let Some((&last, inner)) = kept.split_last() else {
+        return Vec::new();
+    };
+    let near = |i: usize| i > 0 && original[i].distance(start.position) < stopping_m;
+    inner
+        .iter()
+        .copied()
+        .filter(|&i| !near(i))
+        .chain([last])
+        .collect()
 }
 
 /// [`find_path`] from the start's position to `goal`, then [`plan_along`].

@@ -352,3 +352,33 @@ fn a_check_refreshed_along_the_trajectory_equals_one_on_the_full_grid() {
         }
     }
 }
+
+/// Inner path points within a moving start's stopping distance are dropped; at rest, or
+/// beyond it, they stay, and the start and end always stay.
+#[test]
+fn a_moving_start_drops_the_points_within_its_stopping_distance() {
+    let limits = kingfisher();
+    // 2 m/s at 4 m/s^2: 0.5 m to stop.
+    let moving = TrajectoryPoint {
+        velocity: DVec3::new(2.0, 0.0, 0.0),
+        ..TrajectoryPoint::at_rest(DVec3::ZERO, 0.0)
+    };
+    let original: Vec<DVec3> = [0.0, -0.01, -0.3, -0.6, -0.9, -0.2]
+        .iter()
+        .map(|&x| DVec3::new(x, 0.0, 0.0))
+        .collect();
+    let all = [0, 1, 2, 3, 4, 5];
+    assert_eq!(
+        global::beyond_stopping(&all, &original, &moving, &limits),
+        vec![0, 3, 4, 5]
+    );
+    let at_rest = TrajectoryPoint::at_rest(DVec3::ZERO, 0.0);
+    assert_eq!(
+        global::beyond_stopping(&all, &original, &at_rest, &limits),
+        all
+    );
+    assert_eq!(
+        global::beyond_stopping(&[0, 1], &original, &moving, &limits),
+        vec![0, 1]
+    );
+}

@@ -2,8 +2,9 @@
 //! voxels, frontier clusters, each decision's candidate trajectories coloured by predicted
 //! energy with the chosen one marked, the flown paths and poses, over simulated time.
 //!
-//! Behind the `record` cargo feature (the rerun crates add several hundred dependencies).
-//! Without it, [`start`] refuses with [`FEATURE_MISSING`]; only [`colour`] is always built.
+//! Behind the `record` cargo feature (the rerun crates add about 180 crates to the build).
+//! Without it, [`start`] refuses with [`FEATURE_MISSING`]; only the plain data of [`colour`]
+//! and [`path`] is built (and unit-tested) always.
 //!
 //! Layout: [`writer`] is the `.rrd` file, [`recorder`] the resource that remembers what was
 //! logged, [`systems`] the thin systems in the tick, and one module per thing shown
@@ -11,6 +12,7 @@
 //! archetypes with plain functions.
 
 pub mod colour;
+pub mod path;
 
 #[cfg(feature = "record")]
 pub mod candidates;

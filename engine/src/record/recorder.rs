@@ -2,7 +2,7 @@
 //! what each showed when last logged, the flown paths, this tick's decisions).
 
 use super::candidates::CandidateSketch;
-use super::uav::FlownPath;
+use super::path::FlownPath;
 use super::writer::RrdWriter;
 use crate::metrics::Cadence;
 use bevy_ecs::prelude::*;

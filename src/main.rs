@@ -28,6 +28,11 @@ enum Command {
         /// Override the scenario's seed.
         #[arg(long)]
         seed: Option<u64>,
+        /// Write a 3D recording of the run for the rerun viewer (`rerun FILE.rrd`): occupied
+        /// voxels, frontier clusters, candidate trajectories, flown paths, over simulated time.
+        /// Needs the `record` feature.
+        #[arg(long, value_name = "FILE.rrd")]
+        record: Option<PathBuf>,
     },
     /// Check scenario files and report every problem with file, line, column and field.
     Validate {
@@ -182,8 +187,17 @@ fn main() -> ExitCode {
             scenario,
             out,
             seed,
+            record,
         } => {
-            let options = RunOptions { out_dir: out, seed };
+            if record.is_some() && !uavex_engine::record::AVAILABLE {
+                eprintln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
+                return ExitCode::from(INVALID_INPUT);
+            }
+            let options = RunOptions {
+                out_dir: out,
+                seed,
+                record,
+            };
             match run_file(&scenario, &options) {
                 Err(errors) => {
                     eprintln!("{errors}");
@@ -203,6 +217,9 @@ fn main() -> ExitCode {
                     );
                     if let Some(out) = &options.out_dir {
                         println!("results in {}", out.display());
+                    }
+                    if let Some(file) = options.record.as_ref().filter(|f| f.exists()) {
+                        println!("recording in {} (view it with `rerun {0}`)", file.display());
                     }
                     ExitCode::SUCCESS
                 }

@@ -102,3 +102,25 @@ kind = "depth_camera"
         assert!(out_dir.join(file).metadata().unwrap().len() > 0, "{file}");
     }
 }
+
+/// A build without the `record` feature refuses `--record` (exit code 2, naming the feature)
+/// before running anything, rather than running without the recording asked for.
+#[cfg(not(feature = "record"))]
+#[test]
+fn run_refuses_to_record_without_the_record_feature() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("run.rrd");
+    let out = uavex(&[
+        "run",
+        "scenarios/eaae_pillars.toml",
+        "--record",
+        file.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("--record") && err.contains("`record` feature"),
+        "{err}"
+    );
+    assert!(!file.exists());
+}

@@ -9,6 +9,7 @@ pub mod output;
 pub mod physics;
 pub mod plot;
 pub mod reachable;
+pub mod record;
 pub mod run;
 pub mod scenario;
 pub mod sim;

@@ -38,12 +38,43 @@ pub struct UavRow {
     pub rotor_speeds: Option<[f32; 4]>,
 }
 
+/// A fixed rate in simulated time: samples at 0, T, 2T, ... (the series rows, the recording).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Cadence {
+    /// Seconds between samples.
+    pub period_s: f64,
+    next_s: f64,
+}
+
+impl Cadence {
+    pub fn new(rate_hz: f64) -> Self {
+        Self {
+            period_s: 1.0 / rate_hz,
+            next_s: 0.0,
+        }
+    }
+
+    /// Whether a sample is due at `time_s`.
+    pub fn is_due(&self, time_s: f64) -> bool {
+        // A small tolerance keeps samples on the intended grid despite rounding of tick times.
+        time_s + 1e-9 >= self.next_s
+    }
+
+    /// True when a sample is due at `time_s` (then schedules the next one).
+    pub fn take(&mut self, time_s: f64) -> bool {
+        if !self.is_due(time_s) {
+            return false;
+        }
+        self.next_s += self.period_s;
+        true
+    }
+}
+
 /// The run's record, filled in the Account stage.
 #[derive(Resource, Debug, Clone)]
 pub struct RunRecord {
-    /// Seconds between series rows.
-    pub sample_period_s: f64,
-    next_sample_s: f64,
+    /// When series rows are taken.
+    pub series: Cadence,
     pub map_rows: Vec<MapRow>,
     pub uav_rows: Vec<UavRow>,
     /// Simulation time at which each of [`EXPLORED_THRESHOLDS`] was first reached.
@@ -63,8 +94,7 @@ pub struct RunRecord {
 impl RunRecord {
     pub fn new(series_rate_hz: f64, uav_count: usize) -> Self {
         Self {
-            sample_period_s: 1.0 / series_rate_hz,
-            next_sample_s: 0.0,
+            series: Cadence::new(series_rate_hz),
             map_rows: Vec::new(),
             uav_rows: Vec::new(),
             threshold_times_s: [None; 4],
@@ -97,16 +127,6 @@ impl RunRecord {
             self.path_length_m[uav] += f64::from(last.distance(position));
         }
         self.last_position[uav] = Some(position);
-    }
-
-    /// True when a series row is due at `time_s` (then schedules the next one).
-    fn sample_due(&mut self, time_s: f64) -> bool {
-        // A small tolerance keeps rows on the intended grid despite rounding of tick times.
-        if time_s + 1e-9 < self.next_sample_s {
-            return false;
-        }
-        self.next_sample_s += self.sample_period_s;
-        true
     }
 
     /// Appends the final sample unless one was taken at this very time.
@@ -143,7 +163,7 @@ pub fn record_metrics(
     }
     let metrics = totals.metrics(&config);
     record.note_exploration(time_s, metrics.explored_fraction);
-    if !record.sample_due(time_s) {
+    if !record.series.take(time_s) {
         return;
     }
     record.map_rows.push(MapRow { time_s, metrics });
@@ -209,7 +229,7 @@ mod tests {
         let mut r = RunRecord::new(2.0, 0);
         let due: Vec<f64> = (0..=9)
             .map(|i| f64::from(i) * 0.25)
-            .filter(|&t| r.sample_due(t))
+            .filter(|&t| r.series.take(t))
             .collect();
         assert_eq!(due, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
     }

@@ -9,6 +9,7 @@ use crate::output::{
     ExplorationKeys, RunSummary, UavSummary, map_series_csv, uav_series_csv, write_atomically,
 };
 use crate::reachable::ReachableVolume;
+use crate::record;
 use crate::scenario::{self, LoadedScenario, ScenarioErrors};
 use crate::sim::Sim;
 use bevy_ecs::prelude::World;
@@ -31,6 +32,8 @@ pub struct RunOptions {
     pub out_dir: Option<PathBuf>,
     /// Overrides the scenario's seed.
     pub seed: Option<u64>,
+    /// Writes a 3D recording of the run (rerun `.rrd`) to this file (`crate::record`).
+    pub record: Option<PathBuf>,
 }
 
 /// Loads a scenario file and refuses it, with every problem located, if it cannot run as
@@ -53,17 +56,35 @@ pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, 
     let seed = options.seed.unwrap_or(loaded.scenario.seed);
     let started = Instant::now();
     let mut sim = Sim::build(loaded, seed)?;
-    let ending = catch_unwind(AssertUnwindSafe(|| sim.run_to_end()));
-    let (outcome, reason) = ending.unwrap_or_else(|panic| {
-        let message = panic
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| panic.downcast_ref::<&str>().copied())
-            .unwrap_or("unknown panic");
-        (Outcome::Failed, format!("the run panicked: {message}"))
-    });
+    let recording = options
+        .record
+        .as_deref()
+        .map(|file| record::start(&mut sim, file, &loaded.scenario.name));
+    let (outcome, reason) = match &recording {
+        // Asked for a recording that cannot be made: fail before flying, not after.
+        Some(Err(reason)) => (Outcome::Failed, reason.clone()),
+        _ => catch_unwind(AssertUnwindSafe(|| sim.run_to_end())).unwrap_or_else(|panic| {
+            (
+                Outcome::Failed,
+                format!("the run panicked: {}", panic_message(&panic)),
+            )
+        }),
+    };
     // The world may be mid-tick after a panic; what it recorded until then is still valid.
     let mut summary = summarise(&mut sim, &loaded.scenario.name, seed, outcome, reason);
+    if let Some(Ok(())) = recording
+        && let Err(e) =
+            catch_unwind(AssertUnwindSafe(|| record::finish(&mut sim))).unwrap_or_else(|panic| {
+                Err(format!("the recorder panicked: {}", panic_message(&panic)))
+            })
+    {
+        // The run's own ending stays in the reason: a crash must not hide behind a full disk.
+        summary.reason = format!(
+            "could not write the recording {e} (the run: {})",
+            summary.reason
+        );
+        summary.outcome = Outcome::Failed;
+    }
     summary.wall_time_s = started.elapsed().as_secs_f64();
     if let Some(dir) = &options.out_dir
         && let Err(e) = write_outputs(&mut sim, &summary, dir, loaded.scenario.outputs.export_map)
@@ -72,6 +93,15 @@ pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, 
         summary.reason = format!("could not write results to {}: {e}", dir.display());
     }
     Ok(summary)
+}
+
+/// The text a panic was raised with.
+fn panic_message(panic: &(dyn std::any::Any + Send)) -> &str {
+    panic
+        .downcast_ref::<String>()
+        .map(String::as_str)
+        .or_else(|| panic.downcast_ref::<&str>().copied())
+        .unwrap_or("unknown panic")
 }
 
 /// What the summary needs of one UAV: index, name, ending, energy account, prediction.

@@ -267,6 +267,7 @@ fn attempt_run(
     let options = RunOptions {
         out_dir: Some(dir.to_owned()),
         seed: Some(run.seed),
+        record: None,
     };
     let summary = run_scenario(&loaded, &options)
         .map_err(|errors| format!("the world was refused:\n{errors}"))?;

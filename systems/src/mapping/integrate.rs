@@ -10,11 +10,11 @@
 //! Hence a voxel that is both an end point and crossed counts as occupied, and each voxel is
 //! updated at most once per scan, with no per-scan clearing, sorting or allocation.
 //!
-//! Pass 2 walks through bricks whose voxels are all saturated free brick by brick
-//! ([`walk_saturated`]): a miss changes none of them, so the map is the same as if each voxel
+//! Pass 2 crosses bricks whose voxels are all saturated free in one move each
+//! ([`cross_brick`]): a miss changes none of them, so the map is the same as if each voxel
 //! had been visited.
 
-use super::brick::walk_saturated;
+use super::brick::cross_brick;
 use super::dda::{T_ONE, VoxelWalk, clip_segment, to_fixed};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
@@ -239,8 +239,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
     ///   f64 took 1.2 to 1.4 times as long);
     /// - one integer `cursor` holds both the voxel index in the chunk and the chunk-local
     ///   coordinates, biased so that leaving the chunk shows in one mask test;
-    /// - on entering a brick of saturated free voxels, the walk goes on brick by brick
-    ///   ([`walk_saturated`]) while a miss cannot change them (a non-positive miss increment).
+    /// - in a brick of saturated free voxels the walk crosses the brick in one move
+    ///   ([`cross_brick`]), as long as a miss cannot change them (a non-positive miss
+    ///   increment) and the brick's face comes before `t_safe`.
     ///
     /// No lookups, no bounds checks.
     fn walk_fast(
@@ -267,33 +268,33 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let (voxels, saturated) = chunk.voxels_and_saturation_mut();
             let mut cursor = Cursor::at(key);
             let mut changed = 0u64;
+            let mut skipped = 0u64;
             let mut states_changed = false;
-            // The brick whose saturation was last looked at (none yet).
-            let mut brick = u64::MAX;
             loop {
                 let index = cursor.index();
-                if skip_saturated && cursor.brick() != brick {
-                    brick = cursor.brick();
-                    if saturated[brick_of(index)] == BRICK_VOXELS
-                        && let Some(stretch) = walk_saturated(
-                            cursor.local_array(),
-                            [mx, my, mz],
-                            [tx, ty, tz],
-                            [dtx, dty, dtz],
-                            t_safe,
-                            saturated,
-                        )
-                    {
-                        // Every crossing is before `t_safe`, hence before the segment's end: the
-                        // voxels passed are on the walk, and the one entered is too, unless it
-                        // is the excluded end voxel of a hit (then no visit is left).
-                        let passed = stretch.voxels_passed() as u64;
+                if skip_saturated && saturated[brick_of(index)] == BRICK_VOXELS {
+                    let crossing = cross_brick(
+                        cursor.local_array(),
+                        [mx, my, mz],
+                        [tx, ty, tz],
+                        [dtx, dty, dtz],
+                    );
+                    if crossing.face_time < t_safe {
+                        // Every crossing is before `t_safe`, hence before the segment's end:
+                        // the voxels passed are on the walk, and the one entered is too,
+                        // unless it is the excluded end voxel of a hit (then no visit is left).
+                        let passed = crossing.voxels_passed() as u64;
                         debug_assert!(passed <= visits);
                         visits -= passed;
-                        self.report.skipped_voxels += passed;
-                        [tx, ty, tz] = stretch.boundary_times;
-                        let [kx, ky, kz] = stretch.crossings;
-                        cursor.0 = cursor.0.wrapping_add((kx * cx + ky * cy + kz * cz) as u64);
+                        skipped += passed;
+                        [tx, ty, tz] = crossing.boundary_times;
+                        let [kx, ky, kz] = crossing.crossings;
+                        cursor.0 = cursor.0.wrapping_add(
+                            kx.wrapping_mul(cx)
+                                .wrapping_add(ky.wrapping_mul(cy))
+                                .wrapping_add(kz.wrapping_mul(cz))
+                                as u64,
+                        );
                         if visits == 0 || cursor.left_chunk() {
                             break;
                         }
@@ -325,6 +326,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 }
             }
             key = coord.first_key() + cursor.local();
+            self.report.skipped_voxels += skipped;
             if states_changed {
                 chunk.note_state_change();
             }
@@ -381,13 +383,6 @@ impl Cursor {
     #[inline(always)]
     fn left_chunk(self) -> bool {
         self.0 & Self::NIBBLES != Self::INSIDE
-    }
-
-    /// The bits that tell which brick of the chunk the cursor is in: bits 2-3 of each local
-    /// coordinate.
-    #[inline(always)]
-    fn brick(self) -> u64 {
-        self.0 & 0x000C_0C0C_0000_0000
     }
 
     /// Local coordinates inside the chunk (0..16 per axis, while inside).

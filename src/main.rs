@@ -3,6 +3,7 @@
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Duration;
 use uavex_engine::run::{RunOptions, load_and_check, run_file};
 
 #[derive(Parser)]
@@ -33,6 +34,9 @@ enum Command {
         /// Needs the `record` feature.
         #[arg(long, value_name = "FILE.rrd")]
         record: Option<PathBuf>,
+        /// End the run as failed if it takes longer than this in wall-clock time (s).
+        #[arg(long, value_name = "SECONDS", value_parser = wall_limit)]
+        wall_limit: Option<Duration>,
     },
     /// Check scenario files and report every problem with file, line, column and field.
     Validate {
@@ -60,6 +64,10 @@ enum Command {
         /// Run again the runs that failed before (otherwise a failure is a finished result).
         #[arg(long)]
         retry_failed: bool,
+        /// End each run as failed if it takes longer than this in wall-clock time (s); the
+        /// sweep goes on with the others.
+        #[arg(long, value_name = "SECONDS", value_parser = wall_limit)]
+        run_wall_limit: Option<Duration>,
     },
     /// Join the results folders of a plan's shards into one, and write its tables and plots.
     Merge {
@@ -124,6 +132,20 @@ fn parse_override(text: &str) -> Result<(String, f64), String> {
 /// Exit code for a scenario that cannot be run as written.
 const INVALID_INPUT: u8 = 2;
 
+/// A wall-clock limit in seconds: positive and finite.
+fn wall_limit(text: &str) -> Result<Duration, String> {
+    let seconds: f64 = text
+        .parse()
+        .map_err(|_| format!("expected a number of seconds, got {text:?}"))?;
+    if seconds.is_finite() && seconds > 0.0 {
+        Ok(Duration::from_secs_f64(seconds))
+    } else {
+        Err(format!(
+            "expected a positive number of seconds, got {seconds}"
+        ))
+    }
+}
+
 fn main() -> ExitCode {
     match Cli::parse().command {
         Command::Sweep {
@@ -133,6 +155,7 @@ fn main() -> ExitCode {
             shard,
             max_runs,
             retry_failed,
+            run_wall_limit,
         } => {
             let mut options = uavex_engine::sweep::SweepOptions::new(out);
             if let Some(jobs) = jobs {
@@ -141,6 +164,7 @@ fn main() -> ExitCode {
             options.shard = shard;
             options.max_runs = max_runs;
             options.retry_failed = retry_failed;
+            options.run_wall_limit = run_wall_limit;
             options.progress = true;
             sweep_command(&plan, options)
         }
@@ -188,6 +212,7 @@ fn main() -> ExitCode {
             out,
             seed,
             record,
+            wall_limit,
         } => {
             if record.is_some() && !uavex_engine::record::AVAILABLE {
                 eprintln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
@@ -197,6 +222,7 @@ fn main() -> ExitCode {
                 out_dir: out,
                 seed,
                 record,
+                wall_limit,
             };
             match run_file(&scenario, &options) {
                 Err(errors) => {

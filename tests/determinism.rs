@@ -54,7 +54,7 @@ fn run_in_pool(threads: usize, dir: &std::path::Path) -> (RunSummary, String, St
     let options = RunOptions {
         out_dir: Some(dir.to_owned()),
         seed: None,
-        record: None,
+        ..RunOptions::default()
     };
     let mut summary = pool.install(|| run(&loaded, &options)).unwrap();
     summary.wall_time_s = 0.0; // the one field that measures the host, not the run
@@ -84,7 +84,7 @@ fn another_seed_gives_another_run() {
         &RunOptions {
             out_dir: None,
             seed: Some(12),
-            record: None,
+            ..RunOptions::default()
         },
     )
     .unwrap();

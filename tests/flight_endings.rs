@@ -48,7 +48,7 @@ fn a_uav_flown_into_a_wall_crashes_there_and_summary_json_says_so() {
     let options = RunOptions {
         out_dir: Some(dir.path().to_owned()),
         seed: None,
-        record: None,
+        ..RunOptions::default()
     };
     let summary = run(&loaded, &options).unwrap();
     assert_eq!(summary.outcome, Outcome::Crashed, "{}", summary.reason);

@@ -24,7 +24,7 @@ fn the_pillars_tour_completes_with_plausible_energy_and_series() {
     let options = RunOptions {
         out_dir: Some(dir.path().to_owned()),
         seed: None,
-        record: None,
+        ..RunOptions::default()
     };
     let summary = run(&loaded, &options).unwrap();
     assert_eq!(summary.outcome, Outcome::Complete, "{}", summary.reason);

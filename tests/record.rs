@@ -44,6 +44,7 @@ fn run_into(loaded: &LoadedScenario, dir: &Path, record: Option<PathBuf>) -> Run
         out_dir: Some(dir.to_owned()),
         seed: None,
         record,
+        ..RunOptions::default()
     };
     run(loaded, &options).unwrap_or_else(|e| panic!("{e}"))
 }

@@ -182,6 +182,43 @@ fn failing_runs_are_recorded_and_the_others_go_on() {
     );
 }
 
+/// A run that outlives its wall-clock limit is recorded as failed with that reason and what it
+/// had computed; a limit it stays within changes nothing.
+#[test]
+fn a_run_past_its_wall_clock_limit_fails_and_the_sweep_goes_on() {
+    let tmp = tempfile::tempdir().unwrap();
+    // At 1 kHz the clock is first read at 1.024 s, before any of the runs ends.
+    let plan = plan_in(
+        tmp.path(),
+        &format!("{SPEEDS}[set]\n\"physics_rate_hz\" = 1000.0\n"),
+    );
+    let (tight, generous, none) = (
+        tmp.path().join("tight"),
+        tmp.path().join("generous"),
+        tmp.path().join("none"),
+    );
+    let mut options_tight = options(&tight, 2);
+    options_tight.run_wall_limit = Some(std::time::Duration::from_nanos(1));
+    let report = run_sweep(&plan, &options_tight).unwrap();
+    assert_eq!((report.ran, report.failed.len()), (6, 6));
+    for (_, (summary, ..)) in results(&tight) {
+        assert_eq!(summary["outcome"], "failed");
+        let reason = summary["reason"].as_str().unwrap();
+        assert!(
+            reason.starts_with("wall-clock limit of 0.000000001 s exceeded at 1.02 s"),
+            "{reason}"
+        );
+        // What the run computed until then is kept.
+        assert!(summary["known_voxels"].as_u64().unwrap() > 0);
+    }
+    let mut options_generous = options(&generous, 2);
+    options_generous.run_wall_limit = Some(std::time::Duration::from_secs(3600));
+    let report = run_sweep(&plan, &options_generous).unwrap();
+    assert!(report.failed.is_empty());
+    sweep(&plan, &none, 2);
+    assert_eq!(results(&generous), results(&none));
+}
+
 #[test]
 fn the_command_line_runs_shards_merges_and_plots() {
     let tmp = tempfile::tempdir().unwrap();

@@ -34,6 +34,9 @@ pub struct RunOptions {
     pub seed: Option<u64>,
     /// Writes a 3D recording of the run (rerun `.rrd`) to this file (`crate::record`).
     pub record: Option<PathBuf>,
+    /// Ends the run as `failed` once it has taken this long in wall-clock time
+    /// ([`Sim::run_within`]); `None`: only the scenario's simulated time limit.
+    pub wall_limit: Option<std::time::Duration>,
 }
 
 /// Loads a scenario file and refuses it, with every problem located, if it cannot run as
@@ -63,12 +66,14 @@ pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, 
     let (outcome, reason) = match &recording {
         // Asked for a recording that cannot be made: fail before flying, not after.
         Some(Err(reason)) => (Outcome::Failed, reason.clone()),
-        _ => catch_unwind(AssertUnwindSafe(|| sim.run_to_end())).unwrap_or_else(|panic| {
-            (
-                Outcome::Failed,
-                format!("the run panicked: {}", panic_message(&panic)),
-            )
-        }),
+        _ => catch_unwind(AssertUnwindSafe(|| sim.run_within(options.wall_limit))).unwrap_or_else(
+            |panic| {
+                (
+                    Outcome::Failed,
+                    format!("the run panicked: {}", panic_message(&panic)),
+                )
+            },
+        ),
     };
     // The world may be mid-tick after a panic; what it recorded until then is still valid.
     let mut summary = summarise(&mut sim, &loaded.scenario.name, seed, outcome, reason);

@@ -10,6 +10,7 @@ use crate::world::{build_world, check_starts_with_radii, sensor_bundle};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::ScheduleSystem;
 use glam::{DVec3, Vec3};
+use std::time::{Duration, Instant};
 use uavex_components::airframe::Airframe;
 use uavex_components::map::{MapConfig, MapSettings};
 use uavex_components::sensor::SensorId;
@@ -22,6 +23,10 @@ use uavex_systems::flight::track_references;
 use uavex_systems::mapping::{insert_map_resources, integrate_scans};
 use uavex_systems::sensing::sense;
 use uavex_systems::stages::{Stage, tick_schedule};
+
+/// How often (ticks) [`Sim::run_within`] looks at the wall clock: 3.4 s simulated at 300 Hz,
+/// a fraction of a second of wall time.
+pub const WALL_CHECK_TICKS: u64 = 1024;
 
 /// One run in progress.
 pub struct Sim {
@@ -277,9 +282,33 @@ impl Sim {
 
     /// Steps until a system ends the run or the time limit is reached.
     pub fn run_to_end(&mut self) -> (Outcome, String) {
+        self.run_within(None)
+    }
+
+    /// [`Self::run_to_end`], and a run still going after `wall_limit` of wall-clock time
+    /// ends `failed`, with that reason: a safety net against a run that would take forever on
+    /// this machine (a sweep goes on with the others). The clock is read every
+    /// [`WALL_CHECK_TICKS`] ticks and never by a decision, so a run that finishes within the
+    /// limit is the same as without it.
+    pub fn run_within(&mut self, wall_limit: Option<Duration>) -> (Outcome, String) {
+        let deadline = wall_limit.map(|limit| (Instant::now() + limit, limit));
         loop {
             if let Some(end) = self.ended() {
                 return end.clone();
+            }
+            let tick = self.world.resource::<SimClock>().tick;
+            if let Some((deadline, limit)) = deadline
+                && tick > 0
+                && tick % WALL_CHECK_TICKS == 0
+                && Instant::now() >= deadline
+            {
+                let reason = format!(
+                    "wall-clock limit of {} s exceeded at {:.2} s simulated",
+                    limit.as_secs_f64(),
+                    self.time_s()
+                );
+                self.world.resource_mut::<RunEnd>().0 = Some((Outcome::Failed, reason.clone()));
+                return (Outcome::Failed, reason);
             }
             if self.time_s() >= self.time_limit_s {
                 let reason = format!("time limit of {} s reached", self.time_limit_s);

@@ -52,6 +52,8 @@ pub struct SweepOptions {
     pub progress: bool,
     /// Run again the runs that failed before (a failure is otherwise a finished result).
     pub retry_failed: bool,
+    /// Each run's wall-clock limit ([`RunOptions::wall_limit`]).
+    pub run_wall_limit: Option<Duration>,
 }
 
 impl SweepOptions {
@@ -63,6 +65,7 @@ impl SweepOptions {
             max_runs: None,
             progress: false,
             retry_failed: false,
+            run_wall_limit: None,
         }
     }
 }
@@ -172,7 +175,7 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
         todo.par_iter().for_each(|run| {
             let text = &texts[run.scenario_file.as_path()];
             let dir = runs_dir.join(&run.id);
-            let ending = execute_run(run, text, &dir);
+            let ending = execute_run(run, text, &dir, options.run_wall_limit);
             if let Err(reason) = &ending {
                 let first_line = reason.lines().next().unwrap_or_default();
                 bar.println(format!("run {} failed: {first_line}", run.id));
@@ -207,8 +210,13 @@ pub fn has_failed(dir: &Path) -> bool {
 }
 
 /// Runs one run into `dir`; `Err(reason)` when it failed (and its failed summary is written).
-fn execute_run(run: &RunSpec, text: &Result<String, String>, dir: &Path) -> Result<(), String> {
-    let attempt = catch_unwind(AssertUnwindSafe(|| attempt_run(run, text, dir)));
+fn execute_run(
+    run: &RunSpec,
+    text: &Result<String, String>,
+    dir: &Path,
+    wall_limit: Option<Duration>,
+) -> Result<(), String> {
+    let attempt = catch_unwind(AssertUnwindSafe(|| attempt_run(run, text, dir, wall_limit)));
     let outcome = attempt.unwrap_or_else(|panic| {
         let message = panic
             .downcast_ref::<String>()
@@ -249,6 +257,7 @@ fn attempt_run(
     run: &RunSpec,
     text: &Result<String, String>,
     dir: &Path,
+    wall_limit: Option<Duration>,
 ) -> Result<Option<String>, String> {
     // Clear what an interrupted attempt left.
     if dir.exists() {
@@ -268,6 +277,7 @@ fn attempt_run(
         out_dir: Some(dir.to_owned()),
         seed: Some(run.seed),
         record: None,
+        wall_limit,
     };
     let summary = run_scenario(&loaded, &options)
         .map_err(|errors| format!("the world was refused:\n{errors}"))?;

@@ -299,7 +299,7 @@ impl Sim {
             let tick = self.world.resource::<SimClock>().tick;
             if let Some((deadline, limit)) = deadline
                 && tick > 0
-                && tick % WALL_CHECK_TICKS == 0
+                && tick.is_multiple_of(WALL_CHECK_TICKS)
                 && Instant::now() >= deadline
             {
                 let reason = format!(

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 use uavex::components::sim::Outcome;
 use uavex::engine::formats::cloud::load_cloud;
-use uavex::engine::output::RunSummary;
+use uavex::engine::output::{HOST_FIELDS, RunSummary};
 use uavex::engine::record::colour::{Palette, Span};
 use uavex::engine::record::external::re_chunk::{Chunk, ComponentIdentifier};
 use uavex::engine::record::external::re_log_encoding::DecoderApp;
@@ -124,7 +124,7 @@ impl Recording {
 fn summary_of_the_run(dir: &Path) -> serde_json::Value {
     let text = std::fs::read_to_string(dir.join("summary.json")).unwrap();
     let mut json: serde_json::Value = serde_json::from_str(&text).unwrap();
-    for host in ["wall_time_s", "decision_ms_p50", "decision_ms_p95"] {
+    for host in HOST_FIELDS {
         json.as_object_mut().unwrap().remove(host);
     }
     json

@@ -69,9 +69,13 @@ impl UavSummary {
     }
 }
 
+/// The `summary.json` fields that measure the host rather than the run (wall-clock times);
+/// every other field is a pure function of scenario and seed.
+pub const HOST_FIELDS: [&str; 3] = ["wall_time_s", "decision_ms_p50", "decision_ms_p95"];
+
 /// `summary.json`: one run, as a flat record (a row of a sweep's table).
 ///
-/// Every field is a pure function of scenario and seed except `wall_time_s`.
+/// Every field is a pure function of scenario and seed except the [`HOST_FIELDS`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunSummary {
     pub scenario: String,
@@ -116,7 +120,7 @@ pub struct RunSummary {
     #[serde(flatten, default, skip_serializing_if = "Option::is_none")]
     pub exploration: Option<ExplorationKeys>,
     pub uavs: Vec<UavSummary>,
-    /// Host time the run took (s); the one field that is not deterministic.
+    /// Host time the run took (s), one of the [`HOST_FIELDS`].
     pub wall_time_s: f64,
 }
 
@@ -129,7 +133,7 @@ pub struct ExplorationKeys {
     pub completion_time_s: Option<f64>,
     /// Mean |flown - predicted| / predicted energy over the goals reached.
     pub mean_prediction_error: Option<f64>,
-    /// Median and 95th percentile of the wall-clock time of a decision (ms).
+    /// Median and 95th percentile of the wall-clock time of a decision (ms), [`HOST_FIELDS`].
     pub decision_ms_p50: Option<f64>,
     pub decision_ms_p95: Option<f64>,
     /// Known share of the free space connected to the start (%), from the ground truth.

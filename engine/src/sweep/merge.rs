@@ -8,7 +8,7 @@
 use super::execute::{PLAN_FILE, RUNS_DIR, SUMMARY_FILE, SweepError, io_error, is_finished};
 use super::expand::expand;
 use super::plan::Plan;
-use crate::output::write_atomically;
+use crate::output::{HOST_FIELDS, write_atomically};
 use std::path::{Path, PathBuf};
 
 /// What a merge did.
@@ -108,14 +108,16 @@ pub fn finished_runs(runs_dir: &Path) -> Result<Vec<String>, SweepError> {
     Ok(ids)
 }
 
-/// Two summaries agree on everything but the host's wall time.
+/// Two summaries agree on everything but the host's measurements ([`HOST_FIELDS`]).
 fn same_results(a: &Path, b: &Path) -> Result<bool, SweepError> {
     let read = |path: &Path| -> Result<serde_json::Value, SweepError> {
         let text = std::fs::read_to_string(path).map_err(io_error(path))?;
         let mut value: serde_json::Value =
             serde_json::from_str(&text).unwrap_or(serde_json::Value::String(text));
         if let Some(object) = value.as_object_mut() {
-            object.remove("wall_time_s");
+            for field in HOST_FIELDS {
+                object.remove(field);
+            }
         }
         Ok(value)
     };
@@ -134,4 +136,28 @@ fn copy_dir(from: &Path, to: &Path) -> Result<(), SweepError> {
         }
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn summary(dir: &Path, name: &str, energy: f64, wall: f64, decision_ms: f64) -> PathBuf {
+        let path = dir.join(name);
+        let text = format!(
+            r#"{{"outcome": "complete", "energy_j": {energy}, "wall_time_s": {wall}, "decision_ms_p50": {decision_ms}, "decision_ms_p95": {decision_ms}}}"#
+        );
+        std::fs::write(&path, text).unwrap();
+        path
+    }
+
+    #[test]
+    fn runs_agree_whatever_the_host_measured_but_not_when_a_result_differs() {
+        let dir = tempfile::tempdir().unwrap();
+        let a = summary(dir.path(), "a.json", 100.0, 1.0, 20.0);
+        let slower_host = summary(dir.path(), "b.json", 100.0, 3.0, 45.0);
+        let other_result = summary(dir.path(), "c.json", 101.0, 1.0, 20.0);
+        assert!(same_results(&a, &slower_host).unwrap());
+        assert!(!same_results(&a, &other_result).unwrap());
+    }
 }

@@ -131,7 +131,7 @@ fn bench_plain(c: &mut Criterion) {
         let (near, far) = ranges.fold((f32::MAX, 0.0_f32), |(a, b), r| (a.min(r), b.max(r)));
         println!(
             "{name}: {} rays, ranges {near:.2}..{far:.2} m, {} voxel visits per frame \
-             ({} passed over in saturated bricks), {} voxels known, {} chunks",
+             ({} passed over in saturated cubes), {} voxels known, {} chunks",
             report.rays,
             report.voxel_visits,
             report.skipped_voxels,

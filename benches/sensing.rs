@@ -243,16 +243,23 @@ fn flight(c: &mut Criterion) {
             .unwrap();
             report.voxel_visits += r.voxel_visits;
             report.skipped_voxels += r.skipped_voxels;
+            for (total, crossed) in report.cubes_crossed.iter_mut().zip(r.cubes_crossed) {
+                *total += crossed;
+            }
         }
         store.chunk_count()
     };
     let mut report = ScanReport::default();
     fly(&mut report);
     eprintln!(
-        "flight: {} frames, {:.0} voxel visits per frame, {:.1} % passed over in saturated bricks",
+        "flight: {} frames, {:.0} voxel visits per frame, {:.1} % passed over in saturated cubes \
+         (per frame: {:.0} bricks, {:.0} blocks, {:.0} chunks crossed)",
         poses.len(),
         report.voxel_visits as f64 / poses.len() as f64,
-        100.0 * report.skipped_voxels as f64 / report.voxel_visits as f64
+        100.0 * report.skipped_voxels as f64 / report.voxel_visits as f64,
+        report.cubes_crossed[0] as f64 / poses.len() as f64,
+        report.cubes_crossed[1] as f64 / poses.len() as f64,
+        report.cubes_crossed[2] as f64 / poses.len() as f64,
     );
     let mut group = c.benchmark_group("flight");
     group.sample_size(10);

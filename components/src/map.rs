@@ -16,11 +16,12 @@ mod chunk;
 mod config;
 mod grid;
 mod index;
+mod saturation;
 mod stats;
 
 pub use chunk::{
-    BRICK_EDGE, BRICK_VOXELS, CHUNK_BRICKS, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ScanId,
-    UNKNOWN_LOG_ODDS, Voxel, VoxelChunk, VoxelState, brick_of, local_index, local_key,
+    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ScanId, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk, VoxelState,
+    local_index, local_key,
 };
 pub use config::{
     LogOddsIncrements, MAX_BOX_VOXELS, MapConfig, MapConfigError, MapSettings, floor_to_key,
@@ -28,4 +29,7 @@ pub use config::{
 };
 pub use grid::ChunkGrid;
 pub use index::{ChunkIndex, ScanCounter};
+pub use saturation::{
+    BRICK_EDGE, BRICK_VOXELS, BrickSaturation, CHUNK_BRICKS, block_bricks, brick_of,
+};
 pub use stats::{ChunkStats, MapMetrics, MapTotals, STAT_ONE, StatEntry, StatSums, StatTables};

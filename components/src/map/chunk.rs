@@ -1,5 +1,6 @@
 //! Voxel chunks: fixed 16^3 blocks of voxels, each one ECS entity (common.md §1, "Chunks").
 
+use super::saturation::BrickSaturation;
 use bevy_ecs::prelude::*;
 use glam::IVec3;
 
@@ -138,20 +139,6 @@ impl Voxel {
     }
 }
 
-/// Edge of a brick in voxels: a chunk is tiled by 4 x 4 x 4 bricks of 4^3 voxels.
-pub const BRICK_EDGE: i32 = 4;
-/// Voxels in one brick.
-pub const BRICK_VOXELS: u8 = 64;
-/// Bricks in one chunk.
-pub const CHUNK_BRICKS: usize = 64;
-
-/// The brick (0..64, x fastest) holding the voxel with local index `index` ([`local_index`]):
-/// bits 2-3 of each local coordinate.
-#[inline(always)]
-pub fn brick_of(index: usize) -> usize {
-    ((index >> 2) & 0x3) | ((index >> 4) & 0xC) | ((index >> 6) & 0x30)
-}
-
 /// The voxels of one chunk, indexed by [`local_index`], plus the stamp epoch and, per brick,
 /// how many of its voxels are saturated free.
 ///
@@ -160,12 +147,10 @@ pub fn brick_of(index: usize) -> usize {
 /// `epoch == scan.epoch()`; the first touch in a new epoch clears them (once every 65,535 scans
 /// per chunk), so no per-scan clearing or sorting is ever needed.
 ///
-/// **Saturation.** A miss cannot change a voxel already at the lower clamping bound, so a ray
-/// crossing a brick whose 64 voxels are all there changes nothing in it, and the map update
-/// walks past such bricks without visiting their voxels. The count per brick is kept by the
-/// map update ([`Self::voxels_and_saturation_mut`]); it is a lower bound of the true count at
-/// all times (writes through [`Self::voxels_mut`] reset it to zero, and decrements saturate), so
-/// a brick reported full is always truly saturated.
+/// **Saturation.** A miss cannot change a voxel already at the lower clamping bound, so the map
+/// update crosses saturated bricks (and blocks and chunks of them) without visiting their
+/// voxels ([`BrickSaturation`]). The map update keeps the counts
+/// ([`Self::voxels_and_saturation_mut`]); writes through [`Self::voxels_mut`] forget them.
 ///
 /// **State version.** Most updates only move a voxel's log-odds within its state (a free voxel
 /// seen free again); frontiers and traversability depend on the states alone (unknown, free,
@@ -177,7 +162,7 @@ pub fn brick_of(index: usize) -> usize {
 pub struct VoxelChunk {
     voxels: Box<[Voxel; CHUNK_VOXELS]>,
     epoch: u32,
-    saturated: [u8; CHUNK_BRICKS],
+    saturation: BrickSaturation,
     state_version: u32,
 }
 
@@ -193,7 +178,7 @@ impl VoxelChunk {
         Self {
             voxels: Box::new([Voxel::UNKNOWN; CHUNK_VOXELS]),
             epoch: 0,
-            saturated: [0; CHUNK_BRICKS],
+            saturation: BrickSaturation::NONE,
             state_version: 0,
         }
     }
@@ -208,7 +193,7 @@ impl VoxelChunk {
     /// state may change); the map update uses [`Self::voxels_and_saturation_mut`] instead.
     #[inline]
     pub fn voxels_mut(&mut self) -> &mut [Voxel; CHUNK_VOXELS] {
-        self.saturated = [0; CHUNK_BRICKS];
+        self.saturation.forget();
         self.note_state_change();
         &mut self.voxels
     }
@@ -227,19 +212,19 @@ impl VoxelChunk {
         self.state_version = self.state_version.wrapping_add(1);
     }
 
-    /// Mutable voxels and the per-brick saturation counts, for the map update, which keeps the
+    /// Mutable voxels and the saturation of their bricks, for the map update, which keeps the
     /// counts (and [`super::ChunkStats`]) in step with every write.
     #[inline]
     pub fn voxels_and_saturation_mut(
         &mut self,
-    ) -> (&mut [Voxel; CHUNK_VOXELS], &mut [u8; CHUNK_BRICKS]) {
-        (&mut self.voxels, &mut self.saturated)
+    ) -> (&mut [Voxel; CHUNK_VOXELS], &mut BrickSaturation) {
+        (&mut self.voxels, &mut self.saturation)
     }
 
-    /// Whether every voxel of brick `brick` is known to be at the lower clamping bound.
+    /// Which bricks are saturated free.
     #[inline]
-    pub fn brick_saturated(&self, brick: usize) -> bool {
-        self.saturated[brick % CHUNK_BRICKS] == BRICK_VOXELS
+    pub fn saturation(&self) -> &BrickSaturation {
+        &self.saturation
     }
 
     /// Stored log-odds (milli units) at local index `index`.
@@ -280,6 +265,7 @@ impl VoxelChunk {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::map::BRICK_VOXELS;
 
     #[test]
     fn negative_keys_address_the_chunk_below() {
@@ -358,28 +344,16 @@ mod tests {
     }
 
     #[test]
-    fn bricks_tile_the_chunk_by_fours() {
-        let mut voxels_per_brick = [0u8; CHUNK_BRICKS];
-        for z in 0..CHUNK_EDGE {
-            for y in 0..CHUNK_EDGE {
-                for x in 0..CHUNK_EDGE {
-                    let brick = brick_of(local_index(IVec3::new(x, y, z)));
-                    assert_eq!(brick as i32, x / 4 + 4 * (y / 4) + 16 * (z / 4));
-                    voxels_per_brick[brick] += 1;
-                }
-            }
-        }
-        assert!(voxels_per_brick.iter().all(|&n| n == BRICK_VOXELS));
-    }
-
-    #[test]
     fn writing_voxels_by_hand_forgets_saturation_and_bumps_the_state_version() {
         let mut chunk = VoxelChunk::new();
-        chunk.voxels_and_saturation_mut().1[3] = BRICK_VOXELS;
-        assert!(chunk.brick_saturated(3));
+        let saturation = chunk.voxels_and_saturation_mut().1;
+        for _ in 0..BRICK_VOXELS {
+            saturation.add(3);
+        }
+        assert!(chunk.saturation().brick_full(3));
         let version = chunk.state_version();
         chunk.voxels_mut()[0].log_odds = 100;
-        assert!(!chunk.brick_saturated(3));
+        assert!(!chunk.saturation().brick_full(3));
         assert_ne!(chunk.state_version(), version);
     }
 

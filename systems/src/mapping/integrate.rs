@@ -10,17 +10,17 @@
 //! Hence a voxel that is both an end point and crossed counts as occupied, and each voxel is
 //! updated at most once per scan, with no per-scan clearing, sorting or allocation.
 //!
-//! Pass 2 crosses bricks whose voxels are all saturated free in one move each
-//! ([`cross_brick`]): a miss changes none of them, so the map is the same as if each voxel
-//! had been visited.
+//! Pass 2 crosses cubes whose voxels are all saturated free (bricks, blocks of bricks, whole
+//! chunks) in one move each ([`cross_saturated`]): a miss changes none of them, so the map is
+//! the same as if each voxel had been visited.
 
-use super::brick::cross_brick;
+use super::cube::{Cube, cross_saturated};
 use super::dda::{T_ONE, VoxelWalk, clip_segment, to_fixed};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
 use uavex_components::map::{
-    BRICK_VOXELS, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig,
-    ScanId, StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
+    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
+    StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
 };
 use uavex_components::sensor::Scan;
 
@@ -69,8 +69,10 @@ pub struct ScanReport {
     pub voxel_visits: u64,
     /// Voxels whose log-odds changed.
     pub changed_voxels: u64,
-    /// Of the visits, those passed over in saturated bricks (no update needed).
+    /// Of the visits, those passed over in saturated cubes (no update needed).
     pub skipped_voxels: u64,
+    /// Saturated cubes crossed in one move, by size (indexed by [`Cube`]).
+    pub cubes_crossed: [u64; 3],
 }
 
 /// A scan that cannot be integrated (refused before anything is written).
@@ -193,9 +195,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
         chunk.begin_scan(self.scan);
         let before = *stats;
-        let (voxels, saturated) = chunk.voxels_and_saturation_mut();
+        let (voxels, saturation) = chunk.voxels_and_saturation_mut();
         let index = local_index(key) & (CHUNK_VOXELS - 1);
-        let change = update_voxel(voxels, index, saturated, rule, self.tables, stats);
+        let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
         if change.state_changed() {
             chunk.note_state_change();
         }
@@ -239,9 +241,10 @@ impl<C: ChunkAccess> Integration<'_, C> {
     ///   f64 took 1.2 to 1.4 times as long);
     /// - one integer `cursor` holds both the voxel index in the chunk and the chunk-local
     ///   coordinates, biased so that leaving the chunk shows in one mask test;
-    /// - in a brick of saturated free voxels the walk crosses the brick in one move
-    ///   ([`cross_brick`]), as long as a miss cannot change them (a non-positive miss
-    ///   increment) and the brick's face comes before `t_safe`.
+    /// - in a brick of saturated free voxels the walk crosses the largest saturated cube
+    ///   around it (brick, block or chunk) in one move ([`cross_saturated`]), as long as a
+    ///   miss cannot change them (a non-positive miss increment) and the cube's face comes
+    ///   before `t_safe`.
     ///
     /// No lookups, no bounds checks.
     fn walk_fast(
@@ -265,21 +268,28 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
             chunk.begin_scan(self.scan);
             let before = *stats;
-            let (voxels, saturated) = chunk.voxels_and_saturation_mut();
+            let (voxels, saturation) = chunk.voxels_and_saturation_mut();
             let mut cursor = Cursor::at(key);
             let mut changed = 0u64;
             let mut skipped = 0u64;
+            let mut cubes = [0u64; 3];
             let mut states_changed = false;
             loop {
                 let index = cursor.index();
-                if skip_saturated && saturated[brick_of(index)] == BRICK_VOXELS {
-                    let crossing = cross_brick(
+                let brick = brick_of(index);
+                let full_bricks = saturation.full_bricks();
+                if skip_saturated && full_bricks >> brick & 1 == 1 {
+                    let crossing = cross_saturated(
+                        full_bricks,
+                        brick,
                         cursor.local_array(),
                         [mx, my, mz],
                         [tx, ty, tz],
                         [dtx, dty, dtz],
+                        t_safe,
                     );
-                    if crossing.face_time < t_safe {
+                    if let Some((cube, crossing)) = crossing {
+                        cubes[cube as usize] += 1;
                         // Every crossing is before `t_safe`, hence before the segment's end:
                         // the voxels passed are on the walk, and the one entered is too,
                         // unless it is the excluded end voxel of a hit (then no visit is left).
@@ -301,7 +311,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                         continue;
                     }
                 }
-                let change = update_voxel(voxels, index, saturated, rule, self.tables, stats);
+                let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
                 changed += u64::from(change.changed());
                 states_changed |= change.state_changed();
                 visits -= 1;
@@ -327,6 +337,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
             }
             key = coord.first_key() + cursor.local();
             self.report.skipped_voxels += skipped;
+            for (total, crossed) in self.report.cubes_crossed.iter_mut().zip(cubes) {
+                *total += crossed;
+            }
             if states_changed {
                 chunk.note_state_change();
             }

@@ -3,7 +3,7 @@
 //!
 //! - [`dda`]: Amanatides & Woo voxel traversal, clipped to the map.
 //! - [`update`]: the log-odds update of one voxel (stamp, add, clamp, statistics).
-//! - [`brick`]: walking past a brick of saturated free voxels in one move.
+//! - [`cube`]: walking past a cube (brick, block, chunk) of saturated free voxels in one move.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
 //! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
@@ -15,7 +15,7 @@
 //! [`integrate_scans`] to the Map set after sensing. Chunks it creates are spawned through
 //! Commands: systems that read the map later in the same tick must run after a command flush.
 
-pub mod brick;
+pub mod cube;
 pub mod dda;
 pub mod integrate;
 pub mod read;

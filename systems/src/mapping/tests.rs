@@ -428,13 +428,13 @@ fn floor_key(q: DVec3) -> IVec3 {
     q.floor().as_ivec3()
 }
 
-/// The update with saturated bricks walked past in one move gives the same map, voxel for voxel,
+/// The update with saturated cubes crossed in one move gives the same map, voxel for voxel,
 /// as a plain reference that applies common.md §1 to every traversed voxel: hits first, then one
 /// miss for every other voxel any ray crossed, each clamped. Scans from a small region over and
 /// over (so that free space saturates and most of the walk is skipped), two sensor qualities.
 /// The reference shares only the traversal (`for_each_key`, tested against sampling in `dda`).
 #[test]
-fn skipping_saturated_bricks_leaves_the_map_as_a_plain_update_would() {
+fn crossing_saturated_cubes_leaves_the_map_as_a_plain_update_would() {
     let mut m = Mapper::new();
     let config = m.config.clone();
     let (min, max) = (i32::from(config.clamp_min()), i32::from(config.clamp_max()));
@@ -444,31 +444,45 @@ fn skipping_saturated_bricks_leaves_the_map_as_a_plain_update_would() {
         hit: 1386,
         miss: -847,
     };
-    let (mut visits, mut skipped) = (0, 0);
-    for scan in 0..300 {
-        let origin = Vec3::new(
-            rng.random_range(-0.5..0.5),
-            rng.random_range(-0.5..0.5),
-            rng.random_range(-0.5..0.5),
-        );
-        let rays: Vec<(Vec3, bool)> = (0..80)
-            .map(|_| {
-                let d = Vec3::new(
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                )
-                .normalize();
-                // Surfaces 2.5 to 4 m away, free space (and max-range cuts) before them.
-                let hit = rng.random_bool(0.3);
-                let range = if hit { 2.5..4.0 } else { 0.0..2.5 };
-                (origin + d * rng.random_range(range), hit)
-            })
-            .collect();
+    let (mut visits, mut skipped, mut cubes) = (0, 0, [0; 3]);
+    for scan in 0..310 {
+        let rays: Vec<(Vec3, bool)>;
+        let origin;
+        if scan < 10 {
+            // First, dense free scans from near the centre of chunk (0, 0, 0), [0, 1.6)^3 m,
+            // reaching past its corners: they saturate the whole chunk.
+            origin = Vec3::new(0.8 + rng.random_range(-0.05..0.05), 0.8, 0.8);
+            rays = (0..8000)
+                .map(|i| (origin + fibonacci_direction(i, 8000) * 1.5, false))
+                .collect();
+        } else {
+            origin = Vec3::new(
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+                rng.random_range(-0.5..0.5),
+            );
+            rays = (0..80)
+                .map(|_| {
+                    let d = Vec3::new(
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                        rng.random_range(-1.0..1.0),
+                    )
+                    .normalize();
+                    // Surfaces 2.5 to 4 m away, free space (and max-range cuts) before them.
+                    let hit = rng.random_bool(0.3);
+                    let range = if hit { 2.5..4.0 } else { 0.0..2.5 };
+                    (origin + d * rng.random_range(range), hit)
+                })
+                .collect();
+        }
         let inc = if scan % 4 == 3 { lidar } else { OCTOMAP };
         let report = m.scan_with(origin, &rays, inc);
         visits += report.voxel_visits;
         skipped += report.skipped_voxels;
+        for (total, crossed) in cubes.iter_mut().zip(report.cubes_crossed) {
+            *total += crossed;
+        }
 
         let o = config.to_voxel_units(origin);
         let mut hits = BTreeSet::new();
@@ -518,4 +532,14 @@ fn skipping_saturated_bricks_leaves_the_map_as_a_plain_update_would() {
         skipped * 4 > visits,
         "{skipped} of {visits} voxel visits skipped"
     );
+    // Every size of cube was crossed: bricks, blocks and whole chunks.
+    assert!(cubes.iter().all(|&n| n > 0), "cubes crossed {cubes:?}");
+}
+
+/// Direction `i` of `n` spread evenly over the sphere (a Fibonacci lattice).
+fn fibonacci_direction(i: usize, n: usize) -> Vec3 {
+    let z = 1.0 - (2.0 * i as f32 + 1.0) / n as f32;
+    let r = (1.0 - z * z).sqrt();
+    let azimuth = i as f32 * std::f32::consts::PI * (3.0 - 5.0_f32.sqrt());
+    Vec3::new(r * azimuth.cos(), r * azimuth.sin(), z)
 }

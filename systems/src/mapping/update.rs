@@ -1,7 +1,7 @@
 //! The log-odds update of one voxel by one scan (common.md §1, OctoMap semantics).
 
 use uavex_components::map::{
-    CHUNK_BRICKS, CHUNK_VOXELS, StatSums, StatTables, UNKNOWN_LOG_ODDS, Voxel, brick_of,
+    BrickSaturation, CHUNK_VOXELS, StatSums, StatTables, UNKNOWN_LOG_ODDS, Voxel, brick_of,
 };
 
 /// How one scan changes the voxels it updates with one kind of measurement (hit or miss).
@@ -41,13 +41,13 @@ impl VoxelChange {
 
 /// Applies `rule` to voxel `index` of a chunk's `voxels` unless this scan already updated it:
 /// stamps it, adds the increment to its log-odds (an unknown voxel starts from l = 0, p = 0.5),
-/// clamps, and keeps `stats` in step (old value out, new value in), and `saturated`, the count
-/// per brick of voxels at the lower bound (see [`uavex_components::map::VoxelChunk`]).
+/// clamps, and keeps `stats` in step (old value out, new value in), and `saturation`, which
+/// voxels are at the lower bound ([`BrickSaturation`]).
 #[inline(always)]
 pub fn update_voxel(
     voxels: &mut [Voxel; CHUNK_VOXELS],
     index: usize,
-    saturated: &mut [u8; CHUNK_BRICKS],
+    saturation: &mut BrickSaturation,
     rule: UpdateRule,
     tables: &StatTables,
     stats: &mut StatSums,
@@ -61,20 +61,18 @@ pub fn update_voxel(
     let known = old != UNKNOWN_LOG_ODDS;
     let base = if known { i32::from(old) } else { 0 };
     let new = (base + rule.delta).clamp(rule.min, rule.max) as i16;
-    let brick = brick_of(index % CHUNK_VOXELS);
     if known {
         if new == old {
             return VoxelChange::None;
         }
         stats.remove_voxel(old, tables);
         if i32::from(old) == rule.min {
-            // The count is a lower bound (see `VoxelChunk`): never below zero.
-            saturated[brick] = saturated[brick].saturating_sub(1);
+            saturation.remove(brick_of(index));
         }
     }
     stats.add_voxel(new, tables);
     if i32::from(new) == rule.min {
-        saturated[brick] += 1;
+        saturation.add(brick_of(index));
     }
     voxel.log_odds = new;
     // States: unknown (not `known`), free (l < 0), occupied (l >= 0).
@@ -121,11 +119,11 @@ mod tests {
         }
 
         fn change(&mut self, rule: UpdateRule) -> VoxelChange {
-            let (voxels, saturated) = self.chunk.voxels_and_saturation_mut();
+            let (voxels, saturation) = self.chunk.voxels_and_saturation_mut();
             update_voxel(
                 voxels,
                 INDEX,
-                saturated,
+                saturation,
                 rule,
                 &self.tables,
                 &mut self.stats,
@@ -141,7 +139,7 @@ mod tests {
         }
 
         fn saturated(&mut self) -> u8 {
-            self.chunk.voxels_and_saturation_mut().1[brick_of(INDEX)]
+            self.chunk.saturation().count(brick_of(INDEX))
         }
     }
 

@@ -1,0 +1,307 @@
+//! Crossing a cube of saturated free voxels (a 4^3 brick, an 8^3 block of 2 x 2 x 2 bricks,
+//! or a whole 16^3 chunk) in one move.
+//!
+//! A miss cannot change a voxel already at the lower clamping bound (common.md §1: clamping), so
+//! while the map update's ray walk is inside a cube whose voxels are all saturated free
+//! ([`uavex_components::map::BrickSaturation`]), every update would be a no-op.
+//! [`cross_cube`] moves the walk to the first voxel past the cube in one step, with exactly
+//! the crossings and boundary times that stepping voxel by voxel would have reached, ties
+//! included: the map that results is the same bit for bit. Most of what a camera sees in
+//! flight was seen a few frames before, hence saturated: this is where the map update's time
+//! went.
+//!
+//! Boundary times are the walk's fixed-point integers (`dda`): crossing `j` (from now) on axis
+//! `a` is at `t_a + j dt_a` exactly, so the cube's faces and the crossings before them are
+//! computed, not accumulated, and equal the voxel walk's to the last bit.
+
+use uavex_components::map::block_bricks;
+
+/// All ones if `c`, else zero.
+#[inline(always)]
+fn mask(c: bool) -> i64 {
+    -i64::from(c)
+}
+
+/// Intervals above this (2^47 fixed point: 8 segment lengths) are clamped to it in the
+/// comparisons: an axis that slow reaches no second boundary before the segment's end (2^44),
+/// so the counts of crossings before an accepted face are the same, and `t + 15 dt` cannot
+/// overflow.
+const DT_COMPARE_CAP: i64 = 1 << 47;
+
+/// Crossings of an axis from chunk-local coordinate `local` with step `step` up to and
+/// including the one onto the face of its cube of edge `EDGE` ahead (1 to `EDGE`; any value
+/// for an axis that does not move).
+#[inline(always)]
+fn ahead<const EDGE: i64>(local: i64, step: i64) -> i64 {
+    let within = local & (EDGE - 1);
+    if step > 0 { EDGE - within } else { within + 1 }
+}
+
+/// The crossings of an axis (next at `t`, every `dt`) strictly before `before`, knowing there
+/// are fewer than `EDGE` (its own face comes at or after the leaving face): a branch-free
+/// binary search over the count.
+#[inline(always)]
+fn taken<const EDGE: i64>(t: i64, dt: i64, before: i64) -> i64 {
+    let mut count = 0;
+    let mut half = EDGE / 2;
+    while half > 0 {
+        // Is crossing number `count + half - 1` (from 0) before `before`?
+        count += half & mask(t + (count + half - 1) * dt < before);
+        half /= 2;
+    }
+    count
+}
+
+/// The walk's move out of its cube: how many boundaries it crosses on each axis, their new
+/// next-boundary times, and the time of the face it leaves through.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct CubeCrossing {
+    pub crossings: [i64; 3],
+    pub boundary_times: [i64; 3],
+    pub face_time: i64,
+}
+
+impl CubeCrossing {
+    /// Voxels passed: the one the walk stood in and every one entered but the last.
+    #[inline(always)]
+    pub fn voxels_passed(&self) -> i64 {
+        self.crossings[0] + self.crossings[1] + self.crossings[2]
+    }
+}
+
+/// From the voxel at chunk-local coordinates `local` (per axis; only the position within the
+/// cube of edge `EDGE`, a power of two, matters), with steps (+1, -1 or 0 per axis), next
+/// boundary times `t` and intervals `dt` (an axis with step 0 has time `i64::MAX` and interval
+/// 0), the walk's way out of the cube: it leaves through the face reached first, at
+/// `F = min_a t_a + (n_a - 1) dt_a` where axis `a` reaches its face after `n_a` crossings (ties
+/// to x, then y, then z, the walk's rule); every other axis `b` has taken its crossings before
+/// `F`, and the one at `F` too when it wins the tie (`b` before the leaving axis). The caller
+/// makes sure `F` comes before the end of its segment (`face_time` is exact then; otherwise it
+/// is only known to be past 2^47).
+///
+/// Branch-free, on registers: the axis a walk leaves by is as good as random.
+#[inline(always)]
+pub fn cross_cube<const EDGE: i64>(
+    local: [i64; 3],
+    steps: [i64; 3],
+    t: [i64; 3],
+    dt: [i64; 3],
+) -> CubeCrossing {
+    let [tx, ty, tz] = t;
+    let [dtx, dty, dtz] = dt;
+    let [cx, cy, cz] = dt.map(|dt| dt.min(DT_COMPARE_CAP));
+    let fx = tx + (ahead::<EDGE>(local[0], steps[0]) - 1) * cx;
+    let fy = ty + (ahead::<EDGE>(local[1], steps[1]) - 1) * cy;
+    let fz = tz + (ahead::<EDGE>(local[2], steps[2]) - 1) * cz;
+    let x = mask((fx <= fy) & (fx <= fz));
+    let y = !x & mask(fy <= fz);
+    let z = !x & !y;
+    let face = (x & fx) | (y & fy) | (z & fz);
+    // x wins ties against y and z, y against z: at `face`, those go first.
+    let kx = taken::<EDGE>(tx, cx, face + (1 & !x)) + (1 & x);
+    let ky = taken::<EDGE>(ty, cy, face + (1 & z)) + (1 & y);
+    let kz = taken::<EDGE>(tz, cz, face) + (1 & z);
+    CubeCrossing {
+        crossings: [kx, ky, kz],
+        // Exact for an accepted crossing (an axis slower than the cap then takes at most one);
+        // wrapping, so that a rejected one cannot overflow.
+        boundary_times: [
+            tx.wrapping_add(kx.wrapping_mul(dtx)),
+            ty.wrapping_add(ky.wrapping_mul(dty)),
+            tz.wrapping_add(kz.wrapping_mul(dtz)),
+        ],
+        face_time: face,
+    }
+}
+
+/// The cubes the map update crosses in one move.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Cube {
+    /// A 4^3 brick.
+    Brick = 0,
+    /// An 8^3 block of 2 x 2 x 2 bricks.
+    Block = 1,
+    /// A whole 16^3 chunk.
+    Chunk = 2,
+}
+
+/// The largest saturated cube around the walk's voxel (its brick is full: bit `brick` of
+/// `full_bricks`) that it leaves before `t_safe`: the whole chunk when every brick is full,
+/// else the voxel's 8^3 block when its eight bricks are, else the brick; a larger cube whose
+/// face comes too late gives way to the smaller ones. `None` when even the brick's face does.
+#[inline(always)]
+pub fn cross_saturated(
+    full_bricks: u64,
+    brick: usize,
+    local: [i64; 3],
+    steps: [i64; 3],
+    t: [i64; 3],
+    dt: [i64; 3],
+    t_safe: i64,
+) -> Option<(Cube, CubeCrossing)> {
+    let before = |cube: Cube, crossing: CubeCrossing| {
+        (crossing.face_time < t_safe).then_some((cube, crossing))
+    };
+    let block = block_bricks(brick);
+    let chunk = (full_bricks == u64::MAX)
+        .then(|| before(Cube::Chunk, cross_cube::<16>(local, steps, t, dt)))
+        .flatten();
+    let block = || {
+        (full_bricks & block == block)
+            .then(|| before(Cube::Block, cross_cube::<8>(local, steps, t, dt)))
+            .flatten()
+    };
+    chunk
+        .or_else(block)
+        .or_else(|| before(Cube::Brick, cross_cube::<4>(local, steps, t, dt)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    const MAX: i64 = i64::MAX;
+    /// The segment's end in fixed point (`dda::T_ONE`): the map update accepts only crossings
+    /// whose face comes before it.
+    const SEGMENT_END: i64 = 1 << 44;
+
+    /// The axis whose next crossing comes first, ties to x, then y, then z (the walk's rule).
+    fn first(times: [i128; 3]) -> usize {
+        if times[0] <= times[1] && times[0] <= times[2] {
+            0
+        } else if times[1] <= times[2] {
+            1
+        } else {
+            2
+        }
+    }
+
+    /// The voxel walk's own rule, one crossing at a time (in i128: no overflow whatever the
+    /// intervals), until it enters another cube of edge `edge`.
+    fn step_by_voxel(
+        edge: i64,
+        mut local: [i64; 3],
+        steps: [i64; 3],
+        t: [i64; 3],
+        dt: [i64; 3],
+    ) -> CubeCrossing {
+        let mut crossings = [0; 3];
+        let dt = dt.map(i128::from);
+        let mut t = t.map(|t| if t == MAX { i128::MAX } else { i128::from(t) });
+        loop {
+            let a = first(t);
+            let face_time = t[a];
+            let cube_before = local[a].div_euclid(edge);
+            crossings[a] += 1;
+            t[a] += dt[a];
+            local[a] += steps[a];
+            if local[a].div_euclid(edge) != cube_before {
+                let fixed = |t: i128| i64::try_from(t).unwrap_or(MAX);
+                return CubeCrossing {
+                    crossings,
+                    boundary_times: t.map(fixed),
+                    face_time: fixed(face_time),
+                };
+            }
+        }
+    }
+
+    #[test]
+    fn along_x_to_the_face_of_the_brick() {
+        // From local x = 1, crossings every 10 from t = 5: the face (x 3 -> 4) at 25, after 3.
+        let c = cross_cube::<4>([1, 5, 9], [1, 0, 0], [5, MAX, MAX], [10, 0, 0]);
+        assert_eq!(c.crossings, [3, 0, 0]);
+        assert_eq!(c.boundary_times, [35, MAX, MAX]);
+        assert_eq!((c.face_time, c.voxels_passed()), (25, 3));
+        // Going -1 from local x = 6: crossings 6 -> 5 -> 4 -> 3, the face at the third.
+        let c = cross_cube::<4>([6, 0, 0], [-1, 0, 0], [5, MAX, MAX], [10, 0, 0]);
+        assert_eq!((c.crossings, c.face_time), ([3, 0, 0], 25));
+        // The same walk out of its 8^3 block (face 7 -> 8 after 7) and its chunk (15 -> 16).
+        let c = cross_cube::<8>([1, 5, 9], [1, 0, 0], [5, MAX, MAX], [10, 0, 0]);
+        assert_eq!((c.crossings, c.face_time), ([7, 0, 0], 65));
+        let c = cross_cube::<16>([1, 5, 9], [1, 0, 0], [5, MAX, MAX], [10, 0, 0]);
+        assert_eq!((c.crossings, c.face_time), ([15, 0, 0], 145));
+    }
+
+    #[test]
+    fn the_other_axes_take_the_crossings_ordered_before_the_face() {
+        // x crosses every 10 from 5 (its face at 25), y every 7 from 3 going -1 from local
+        // y 2 (its face, 2 -> 1 -> 0 -> -1, at 3 + 2 * 7 = 17): y leaves first, by when x has
+        // crossed at 5 and 15.
+        let c = cross_cube::<4>([1, 2, 0], [1, -1, 0], [5, 3, MAX], [10, 7, 0]);
+        assert_eq!(c.crossings, [2, 3, 0]);
+        assert_eq!(c.boundary_times, [25, 24, MAX]);
+        // A tie: x's face and y's face both at 25 (y from local 0 going +1: 4, 11, 18, 25).
+        // x wins it and leaves; y has taken its crossings at 4, 11 and 18, not the one at 25.
+        let c = cross_cube::<4>([1, 0, 0], [1, 1, 0], [5, 4, MAX], [10, 7, 0]);
+        assert_eq!(c.crossings, [3, 3, 0]);
+        assert_eq!(c.boundary_times, [35, 25, MAX]);
+        // y's face against an interior x crossing at 18 (x from local 0: 4, 11, 18, face 25;
+        // y from local 2: 8, face 18): x, first in ties, takes it before y leaves.
+        let c = cross_cube::<4>([0, 2, 0], [1, 1, 0], [4, 8, MAX], [7, 10, 0]);
+        assert_eq!(c.crossings, [3, 2, 0]);
+        assert_eq!(c.boundary_times, [25, 28, MAX]);
+        assert_eq!(c.face_time, 18);
+    }
+
+    /// On random walks (small integers, so that ties are frequent; large ones; and intervals
+    /// up to the walk's cap of 2^60, past the comparisons' cap), one move equals stepping
+    /// voxel by voxel out of the cube whenever its face comes before the segment's end, and
+    /// says it comes later otherwise.
+    fn one_move_equals_stepping_voxel_by_voxel<const EDGE: i64>(seed: u64) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut accepted = 0;
+        for case in 0..200_000 {
+            let steps = [0; 3].map(|_| rng.random_range(-1..=1i64));
+            if steps == [0; 3] {
+                continue;
+            }
+            let local = [0; 3].map(|_| rng.random_range(0..16i64));
+            let mut t = [0; 3];
+            let mut dt = [0; 3];
+            for a in 0..3 {
+                if steps[a] == 0 {
+                    t[a] = MAX;
+                } else {
+                    dt[a] = match case % 3 {
+                        0 => rng.random_range(1..6),
+                        1 => rng.random_range(1..1i64 << 41),
+                        _ => 1i64 << rng.random_range(30..=60),
+                    };
+                    // A boundary may be due at once (t = 0): a walk starting on a face.
+                    t[a] = rng.random_range(0..=dt[a]);
+                }
+            }
+            let expected = step_by_voxel(EDGE, local, steps, t, dt);
+            let moved = cross_cube::<EDGE>(local, steps, t, dt);
+            let context = format!("case {case}: local {local:?} steps {steps:?} t {t:?} dt {dt:?}");
+            if expected.face_time < SEGMENT_END {
+                assert_eq!(moved, expected, "{context}");
+                accepted += 1;
+            } else {
+                assert!(moved.face_time >= SEGMENT_END, "{context}");
+            }
+        }
+        assert!(
+            accepted > 100_000,
+            "only {accepted} cases crossed before the end"
+        );
+    }
+
+    #[test]
+    fn one_move_out_of_a_brick_equals_stepping_voxel_by_voxel() {
+        one_move_equals_stepping_voxel_by_voxel::<4>(11);
+    }
+
+    #[test]
+    fn one_move_out_of_a_block_equals_stepping_voxel_by_voxel() {
+        one_move_equals_stepping_voxel_by_voxel::<8>(12);
+    }
+
+    #[test]
+    fn one_move_out_of_a_chunk_equals_stepping_voxel_by_voxel() {
+        one_move_equals_stepping_voxel_by_voxel::<16>(13);
+    }
+}

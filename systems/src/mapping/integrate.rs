@@ -14,7 +14,7 @@
 //! chunks) in one move each ([`cross_saturated`]): a miss changes none of them, so the map is
 //! the same as if each voxel had been visited.
 
-use super::cube::{Cube, cross_saturated};
+use super::cube::cross_saturated;
 use super::dda::{T_ONE, VoxelWalk, clip_segment, to_fixed};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
@@ -71,7 +71,7 @@ pub struct ScanReport {
     pub changed_voxels: u64,
     /// Of the visits, those passed over in saturated cubes (no update needed).
     pub skipped_voxels: u64,
-    /// Saturated cubes crossed in one move, by size (indexed by [`Cube`]).
+    /// Saturated cubes crossed in one move, by size (indexed by [`super::cube::Cube`]).
     pub cubes_crossed: [u64; 3],
 }
 

@@ -48,7 +48,7 @@ pub struct Band {
 const MAX_POINTS: usize = 2000;
 
 /// The band of `curves` on a grid from 0 to the last sample of any of them, with the finest
-/// median sampling step among them (coarsened to at most [`MAX_POINTS`] points).
+/// median sampling step among them (coarsened to at most `MAX_POINTS` points).
 pub fn band(curves: &[Curve]) -> Option<Band> {
     let curves: Vec<&Curve> = curves.iter().filter(|c| !c.times.is_empty()).collect();
     let end = curves

@@ -6,9 +6,9 @@
 //! Without it, [`start`] refuses with [`FEATURE_MISSING`]; only the plain data of [`colour`]
 //! and [`path`] is built (and unit-tested) always.
 //!
-//! Layout: [`writer`] is the `.rrd` file, [`recorder`] the resource that remembers what was
-//! logged, [`systems`] the thin systems in the tick, and one module per thing shown
-//! ([`map`], [`frontier`], [`candidates`], [`uav`], [`plots`]) turning uavex data into rerun
+//! Layout (with the feature): `writer` is the `.rrd` file, `recorder` the resource that
+//! remembers what was logged, `systems` the thin systems in the tick, and one module per thing
+//! shown (`map`, `frontier`, `candidates`, `uav`, `plots`) turning uavex data into rerun
 //! archetypes with plain functions.
 
 pub mod colour;

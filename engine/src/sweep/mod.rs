@@ -4,9 +4,9 @@
 //!
 //! - [`plan`]: the plan file (TOML) and its checks;
 //! - [`path`] and [`apply`]: field paths and how an override edits a scenario's text;
-//! - [`expand`]: runs, their ids, shards;
+//! - [`expand`](mod@expand): runs, their ids, shards;
 //! - [`execute`]: running a plan into a results folder;
-//! - [`merge`]: joining shard folders.
+//! - [`merge`](mod@merge): joining shard folders.
 //!
 //! A run is a pure function of its scenario (with overrides) and seed, and nothing a run
 //! computes depends on the thread that runs it or on the other runs, so a sweep gives the same

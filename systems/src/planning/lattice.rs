@@ -93,7 +93,7 @@ impl Lattice {
         lattice
     }
 
-    /// Whether the map had room for a lattice (see [`MAX_LATTICE_CELLS`]).
+    /// Whether the map had room for a lattice (see `MAX_LATTICE_CELLS`).
     pub fn is_available(&self) -> bool {
         !self.cells.is_empty()
     }

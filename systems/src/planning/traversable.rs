@@ -205,7 +205,7 @@ impl TraversableGrid {
         }
     }
 
-    /// Recomputes the dirty chunks from `map` (see [`Self::follow_geometry`] for a map of
+    /// Recomputes the dirty chunks from `map` (see `follow_geometry` for a map of
     /// another geometry).
     pub fn refresh(&mut self, map: &impl OccupancyMap) {
         self.follow_geometry(map);

@@ -1,6 +1,6 @@
 //! Strategies (eaae.md step 8 and "Baselines"): each is one system in [`DecideStep::Choose`]
 //! that looks at the candidates of the UAVs carrying its marker component and marks its pick
-//! with [`Chosen`]. Detection, clustering, filtering, planning and rollouts are shared; only the
+//! with [`Chosen`](uavex_components::exploration::Chosen). Detection, clustering, filtering, planning and rollouts are shared; only the
 //! choice differs. A new strategy is a new marker and a new system, added with
 //! `schedule.add_systems(my_choice.in_set(DecideStep::Choose))`: nothing here changes.
 //!

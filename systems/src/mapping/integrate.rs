@@ -201,8 +201,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
         if change.state_changed() {
             chunk.note_state_change();
         }
-        self.totals.add_change(&before, stats);
         if change.changed() {
+            // A voxel's statistics change only with its log-odds.
+            self.totals.add_change(&before, stats);
             self.report.changed_voxels += 1;
             self.chunks.mark_written(flat);
         }
@@ -343,8 +344,10 @@ impl<C: ChunkAccess> Integration<'_, C> {
             if states_changed {
                 chunk.note_state_change();
             }
-            self.totals.add_change(&before, stats);
             if changed > 0 {
+                // Statistics change only with log-odds: most visits (crossings of saturated
+                // cubes, voxels seen again) change none.
+                self.totals.add_change(&before, stats);
                 self.report.changed_voxels += changed;
                 self.chunks.mark_written(flat);
             }

@@ -40,11 +40,11 @@ use uavex_engine::scenario::load;
 use uavex_engine::sim::Sim;
 use uavex_systems::exploration::DecideStep;
 use uavex_systems::exploration::propose::{
-    ClusterTarget, PlannedCandidate, cluster_targets, plan_decision, planning_start,
+    ClusterTarget, PlannedCandidate, cluster_targets, goal_rollout, plan_decision, planning_start,
     propose_candidates, roll_out_candidates,
 };
 use uavex_systems::flight::ecs::ReferenceTrajectory;
-use uavex_systems::flight::{Completion, FlightState, RolloutConfig};
+use uavex_systems::flight::{FlightState, RolloutConfig};
 use uavex_systems::frontier::{cluster_frontier, divisive_two_means};
 use uavex_systems::mapping::MapReader;
 use uavex_systems::planning::{Traversability, TraversableGrid};
@@ -113,14 +113,7 @@ fn snapshot(
             flight: FlightState::from(state),
             airframe: airframe.clone(),
             limits: DynamicLimits::of(airframe),
-            config: RolloutConfig {
-                completion: Completion {
-                    position_tolerance: s.goal_tolerance_m,
-                    speed_tolerance: s.goal_speed_tolerance,
-                    ..Completion::default()
-                },
-                ..RolloutConfig::default()
-            },
+            config: goal_rollout(s),
             position: state.position,
             min_goal_distance_m: s.min_goal_distance_m,
             min_travel_m: s.goal_tolerance_m,

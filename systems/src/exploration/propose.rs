@@ -23,8 +23,8 @@ use rayon::prelude::*;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{
-    CandidateScope, CandidateTrajectory, DecisionTiming, Explorer, For, NeedsDecision,
-    PredictedDuration, PredictedEnergy, Toward, Unaffordable,
+    CandidateScope, CandidateTrajectory, DecisionTiming, Explorer, ExplorerSettings, For,
+    NeedsDecision, PredictedDuration, PredictedEnergy, Toward, Unaffordable,
 };
 use uavex_components::frontier::{FrontierCluster, Reachable, Viewpoint, Viewpoints};
 use uavex_components::sim::SimClock;
@@ -82,6 +82,19 @@ pub fn roll_out_candidates(
         .par_iter()
         .map(|candidate| rollout(airframe, start, &candidate.plan.trajectory, config).ok())
         .collect()
+}
+
+/// The rollout of a candidate: it ends a flight by the same rule the goal is judged by when
+/// flown (the explorer's goal tolerances).
+pub fn goal_rollout(settings: &ExplorerSettings) -> RolloutConfig {
+    RolloutConfig {
+        completion: Completion {
+            position_tolerance: settings.goal_tolerance_m,
+            speed_tolerance: settings.goal_speed_tolerance,
+            ..Completion::default()
+        },
+        ..RolloutConfig::default()
+    }
 }
 
 /// Where a new trajectory starts: the reference the controller tracks now (so the commanded
@@ -204,15 +217,7 @@ pub fn propose_candidates(
             flight: FlightState::from(state),
             airframe,
             limits,
-            // The rollout ends a flight by the same rule the goal is judged by when flown.
-            rollout: RolloutConfig {
-                completion: Completion {
-                    position_tolerance: settings.goal_tolerance_m,
-                    speed_tolerance: settings.goal_speed_tolerance,
-                    ..Completion::default()
-                },
-                ..RolloutConfig::default()
-            },
+            rollout: goal_rollout(settings),
             min_travel_m: settings.goal_tolerance_m,
             budget: settings
                 .budget

@@ -14,10 +14,10 @@
 //!   empty: the cost of frames in flight, where each sees new space next to saturated space.
 //!   Throughput is in frames.
 
-use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use glam::{DVec3, Quat, Vec3};
 use std::hint::black_box;
-use uavex_components::map::{MapConfig, MapSettings, ScanId, StatSums};
+use uavex_components::map::{LogOddsIncrements, MapConfig, MapSettings, ScanId, StatSums};
 use uavex_components::sensor::{Scan, SensorQuality};
 use uavex_components::sim::RunSeed;
 use uavex_components::world::WorldGeometry;
@@ -215,60 +215,121 @@ fn flight_poses() -> Vec<SensorPose> {
     poses
 }
 
-fn flight(c: &mut Criterion) {
-    let (world, map) = pillars();
-    let increments = map
-        .increments(&SensorQuality::from_probabilities(0.7, 0.4, 0.0))
-        .unwrap();
-    let auto = camera_pattern(THESIS_CAMERA, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).unwrap();
-    let poses = flight_poses();
-    let mut scratch = SweepScratch::default();
-    let mut scan = Scan::default();
-    let mut fly = |report: &mut ScanReport| {
-        let mut store = ChunkStore::new(&map);
+/// The flight of [`flight_poses`], swept and integrated frame by frame into a new map; adds
+/// each frame's report to `report` and returns the number of chunks made.
+struct Flight {
+    world: WorldGeometry,
+    map: MapConfig,
+    increments: LogOddsIncrements,
+    auto: RayPattern,
+    poses: Vec<SensorPose>,
+    scratch: SweepScratch,
+    scan: Scan,
+}
+
+impl Flight {
+    fn new() -> Self {
+        let (world, map) = pillars();
+        let increments = map
+            .increments(&SensorQuality::from_probabilities(0.7, 0.4, 0.0))
+            .unwrap();
+        let auto =
+            camera_pattern(THESIS_CAMERA, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).unwrap();
+        Self {
+            world,
+            map,
+            increments,
+            auto,
+            poses: flight_poses(),
+            scratch: SweepScratch::default(),
+            scan: Scan::default(),
+        }
+    }
+
+    fn fly(&mut self, report: &mut ScanReport) -> usize {
+        let mut store = ChunkStore::new(&self.map);
         let mut totals = StatSums::default();
         let mut id = None;
-        for &pose in &poses {
-            sweep(&auto, pose, &world, None, &mut scratch, &mut scan, 0.0);
+        for &pose in &self.poses {
+            let (pattern, world) = (&self.auto, &self.world);
+            sweep(
+                pattern,
+                pose,
+                world,
+                None,
+                &mut self.scratch,
+                &mut self.scan,
+                0.0,
+            );
             let scan_id = ScanId::after(id);
             id = Some(scan_id);
             let r = integrate_scan(
-                &map,
+                &self.map,
                 scan_id,
-                ScanRays::of(&scan),
-                increments,
+                ScanRays::of(&self.scan),
+                self.increments,
                 &mut store,
                 &mut totals,
             )
             .unwrap();
             report.voxel_visits += r.voxel_visits;
             report.skipped_voxels += r.skipped_voxels;
+            report.chunk_visits += r.chunk_visits;
             for (total, crossed) in report.cubes_crossed.iter_mut().zip(r.cubes_crossed) {
                 *total += crossed;
             }
         }
         store.chunk_count()
-    };
+    }
+}
+
+fn flight(c: &mut Criterion) {
+    let mut flight = Flight::new();
+    let frames = flight.poses.len();
     let mut report = ScanReport::default();
-    fly(&mut report);
+    flight.fly(&mut report);
     eprintln!(
         "flight: {} frames, {:.0} voxel visits per frame, {:.1} % passed over in saturated cubes \
-         (per frame: {:.0} bricks, {:.0} blocks, {:.0} chunks crossed)",
-        poses.len(),
-        report.voxel_visits as f64 / poses.len() as f64,
+         (per frame: {:.0} bricks, {:.0} blocks, {:.0} chunks crossed; {:.0} chunk visits)",
+        frames,
+        report.voxel_visits as f64 / frames as f64,
         100.0 * report.skipped_voxels as f64 / report.voxel_visits as f64,
-        report.cubes_crossed[0] as f64 / poses.len() as f64,
-        report.cubes_crossed[1] as f64 / poses.len() as f64,
-        report.cubes_crossed[2] as f64 / poses.len() as f64,
+        report.cubes_crossed[0] as f64 / frames as f64,
+        report.cubes_crossed[1] as f64 / frames as f64,
+        report.cubes_crossed[2] as f64 / frames as f64,
+        report.chunk_visits as f64 / frames as f64,
     );
     let mut group = c.benchmark_group("flight");
     group.sample_size(10);
-    group.throughput(Throughput::Elements(poses.len() as u64));
+    group.throughput(Throughput::Elements(frames as u64));
     group.bench_function("thesis_camera_auto_frames", |b| {
-        b.iter(|| black_box(fly(&mut ScanReport::default())))
+        b.iter(|| black_box(flight.fly(&mut ScanReport::default())))
     });
     group.finish();
 }
 
 criterion_group!(benches, raycast, sense_and_map, flight);
-criterion_main!(benches);
+
+/// `SENSING_PROFILE_FLIGHT=n cargo bench --bench sensing`: fly the flight n times and nothing
+/// else, for profilers that count instructions (callgrind), where criterion's timing loop
+/// would run a varying number of iterations.
+fn main() {
+    if let Some(n) = std::env::var("SENSING_PROFILE_FLIGHT")
+        .ok()
+        .and_then(|n| n.parse::<usize>().ok())
+    {
+        let mut flight = Flight::new();
+        let mut report = ScanReport::default();
+        for _ in 0..n {
+            black_box(flight.fly(&mut report));
+        }
+        eprintln!(
+            "{n} flights of {} frames: {} voxel visits",
+            flight.poses.len(),
+            report.voxel_visits
+        );
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -183,6 +183,20 @@ impl VoxelChunk {
         }
     }
 
+    /// A chunk of unknown voxels at `coord` in a map of keys `key_min..=key_max`: its voxels
+    /// outside the map count as saturated ([`BrickSaturation::outside`]). The map update
+    /// makes its chunks this way.
+    pub fn in_map(coord: ChunkCoord, key_min: IVec3, key_max: IVec3) -> Self {
+        let first = coord.first_key();
+        Self {
+            saturation: BrickSaturation::outside(
+                (key_min - first).to_array(),
+                (key_max - first).to_array(),
+            ),
+            ..Self::new()
+        }
+    }
+
     #[inline]
     pub fn voxels(&self) -> &[Voxel; CHUNK_VOXELS] {
         &self.voxels

@@ -70,6 +70,34 @@ impl BrickSaturation {
         full: 0,
     };
 
+    /// Counts for a chunk whose voxels with chunk-local coordinates outside `lo..=hi` (per
+    /// axis; the range may reach past the chunk or be empty) lie outside the map: those count
+    /// as saturated from the start.
+    ///
+    /// Why: the map update never updates or visits a voxel outside the map (every ray is
+    /// clipped to the map's key box, and a cube is crossed only when the ray leaves it before
+    /// its clipped end, so every voxel it passes is inside the map). Counted, they let the
+    /// bricks, blocks and chunks on the map's border fill up like any other; uncounted, they
+    /// could never be full, and every ray reaching a wall or the ceiling of the map walked its
+    /// last brick voxel by voxel (in a 2.5 m high scene, the whole upper layer of chunks).
+    pub fn outside(lo: [i32; 3], hi: [i32; 3]) -> Self {
+        let inside = |axis: usize, brick: i32| {
+            let first = brick * BRICK_EDGE;
+            let last = first + BRICK_EDGE - 1;
+            (hi[axis].min(last) - lo[axis].max(first) + 1).max(0)
+        };
+        let mut saturation = Self::NONE;
+        for brick in 0..CHUNK_BRICKS {
+            let [x, y, z] = [brick % 4, (brick / 4) % 4, brick / 16].map(|b| b as i32);
+            let outside = i32::from(BRICK_VOXELS) - inside(0, x) * inside(1, y) * inside(2, z);
+            saturation.counts[brick] = outside as u8;
+            if outside == i32::from(BRICK_VOXELS) {
+                saturation.full |= 1 << brick;
+            }
+        }
+        saturation
+    }
+
     /// A voxel of `brick` reached the lower bound.
     #[inline(always)]
     pub fn add(&mut self, brick: usize) {
@@ -149,6 +177,31 @@ mod tests {
             assert_eq!(block_bricks(b).count_ones(), 8);
             assert_ne!(block_bricks(b) & 1 << brick(x, y, z), 0);
         }
+    }
+
+    #[test]
+    fn voxels_outside_the_map_count_as_saturated() {
+        // In-map voxels: x 0..=9, y 3..=15, z 0..=16 (past the chunk: all of z).
+        let saturation = BrickSaturation::outside([0, 3, 0], [9, 15, 16]);
+        let brick = |x: usize, y: usize, z: usize| x + 4 * y + 16 * z;
+        // Brick x 0..=3, y 0..=3: rows y = 0, 1, 2 are outside: 64 - 4 * 1 * 4.
+        assert_eq!(saturation.count(brick(0, 0, 2)), 48);
+        // Brick x 8..=11, y 4..=7: columns x = 10, 11 are outside: 64 - 2 * 4 * 4.
+        assert_eq!(saturation.count(brick(2, 1, 0)), 32);
+        // Brick x 12..=15 lies wholly outside: full from the start; inner bricks count none.
+        assert_eq!(saturation.count(brick(3, 2, 1)), 64);
+        assert!(saturation.brick_full(brick(3, 2, 1)));
+        assert_eq!(saturation.count(brick(1, 2, 3)), 0);
+        let full = (0..4).flat_map(|z| (0..4).map(move |y| brick(3, y, z)));
+        assert_eq!(
+            saturation.full_bricks(),
+            full.fold(0, |set, b| set | 1 << b)
+        );
+        // A chunk wholly inside the map starts with nothing counted.
+        assert_eq!(
+            BrickSaturation::outside([-5, 0, 0], [20, 15, 99]),
+            BrickSaturation::NONE
+        );
     }
 
     #[test]

@@ -51,45 +51,100 @@ pub struct ClippedSegment {
 /// Clips the segment `start -> end` (voxel units) to the keys `lo..=hi`; `None` if it misses the
 /// box (or only grazes its surface from outside).
 pub fn clip_segment(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3) -> Option<ClippedSegment> {
-    let inside = |k: IVec3| k.cmpge(lo).all() && k.cmple(hi).all();
-    // Points on the segment keep their key when inside (the same `floor` every key
-    // computation uses); entry and exit points are clamped into the box against rounding.
-    let (raw_start, raw_end) = (floor_to_key(start), floor_to_key(end));
-    let (start_inside, end_inside) = (inside(raw_start), inside(raw_end));
-    if start_inside && end_inside {
-        // The box is convex: nothing to clip (the common case, worth skipping the slabs).
-        return Some(ClippedSegment {
-            start_key: raw_start,
-            end_key: raw_end,
-            end_inside,
-            t_end: 1.0,
-        });
-    }
-    let d = end - start;
-    let (box_lo, box_hi) = (lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
-    let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
-    for axis in 0..3 {
-        if d[axis] == 0.0 {
-            if start[axis] < box_lo[axis] || start[axis] >= box_hi[axis] {
-                return None;
-            }
-        } else {
-            let ta = (box_lo[axis] - start[axis]) / d[axis];
-            let tb = (box_hi[axis] - start[axis]) / d[axis];
-            t0 = t0.max(ta.min(tb));
-            t1 = t1.min(ta.max(tb));
+    SegmentClipper::new(start, lo, hi).clip(end)
+}
+
+/// [`clip_segment`] for many segments from one start (a scan's rays from its origin): the
+/// start's key is found once.
+#[derive(Debug, Clone, Copy)]
+pub struct SegmentClipper {
+    start: DVec3,
+    start_key: IVec3,
+    start_inside: bool,
+    lo: IVec3,
+    hi: IVec3,
+}
+
+impl SegmentClipper {
+    pub fn new(start: DVec3, lo: IVec3, hi: IVec3) -> Self {
+        let start_key = floor_to_key(start);
+        Self {
+            start,
+            start_key,
+            start_inside: start_key.cmpge(lo).all() && start_key.cmple(hi).all(),
+            lo,
+            hi,
         }
     }
-    if t0 > t1 || (t0 == t1 && !start_inside && !end_inside) {
-        return None;
+
+    /// The segment from the start to `end`, clipped ([`clip_segment`]).
+    pub fn clip(&self, end: DVec3) -> Option<ClippedSegment> {
+        let Self {
+            start,
+            start_key: raw_start,
+            start_inside,
+            lo,
+            hi,
+        } = *self;
+        // Points on the segment keep their key when inside (the same `floor` every key
+        // computation uses); entry and exit points are clamped into the box against rounding.
+        let raw_end = floor_to_key(end);
+        let end_inside = raw_end.cmpge(lo).all() && raw_end.cmple(hi).all();
+        if start_inside && end_inside {
+            // The box is convex: nothing to clip (the common case, worth skipping the slabs).
+            return Some(ClippedSegment {
+                start_key: raw_start,
+                end_key: raw_end,
+                end_inside,
+                t_end: 1.0,
+            });
+        }
+        let d = end - start;
+        let (box_lo, box_hi) = (lo.as_dvec3(), (hi + IVec3::ONE).as_dvec3());
+        let key_at = |t: f64| floor_to_key(start + d * t).clamp(lo, hi);
+        if start_inside {
+            // Leaving the box (a ray ending on a wall or the floor beyond the map's border: a third
+            // of a camera frame's rays). Only the axes on which the end lies outside can cut the
+            // segment: on the others both ends lie in the slab, so their exit parameter, computed
+            // as below, is at least 1 (rounding is monotonic). Same parameters, one division.
+            let mut t1 = 1.0_f64;
+            for axis in 0..3 {
+                if raw_end[axis] < lo[axis] {
+                    t1 = t1.min((box_lo[axis] - start[axis]) / d[axis]);
+                } else if raw_end[axis] > hi[axis] {
+                    t1 = t1.min((box_hi[axis] - start[axis]) / d[axis]);
+                }
+            }
+            return Some(ClippedSegment {
+                start_key: raw_start,
+                end_key: key_at(t1),
+                end_inside,
+                t_end: t1,
+            });
+        }
+        let (mut t0, mut t1) = (0.0_f64, 1.0_f64);
+        for axis in 0..3 {
+            if d[axis] == 0.0 {
+                if start[axis] < box_lo[axis] || start[axis] >= box_hi[axis] {
+                    return None;
+                }
+            } else {
+                let ta = (box_lo[axis] - start[axis]) / d[axis];
+                let tb = (box_hi[axis] - start[axis]) / d[axis];
+                t0 = t0.max(ta.min(tb));
+                t1 = t1.min(ta.max(tb));
+            }
+        }
+        if t0 > t1 || (t0 == t1 && !start_inside && !end_inside) {
+            return None;
+        }
+        Some(ClippedSegment {
+            start_key: key_at(t0),
+            end_key: if end_inside { raw_end } else { key_at(t1) },
+            end_inside,
+            t_end: t1,
+        })
     }
-    let key_at = |t: f64| floor_to_key(start + d * t).clamp(lo, hi);
-    Some(ClippedSegment {
-        start_key: if start_inside { raw_start } else { key_at(t0) },
-        end_key: if end_inside { raw_end } else { key_at(t1) },
-        end_inside,
-        t_end: t1,
-    })
 }
 
 /// The state of a traversal from `start_key` to `end_key` along the segment `start -> end`.

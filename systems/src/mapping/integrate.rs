@@ -14,8 +14,8 @@
 //! chunks) in one move each ([`cross_saturated`]): a miss changes none of them, so the map is
 //! the same as if each voxel had been visited.
 
-use super::cube::cross_saturated;
-use super::dda::{T_ONE, VoxelWalk, clip_segment, to_fixed};
+use super::cube::{Cube, CubeLimit, cross_cube, cross_saturated};
+use super::dda::{SegmentClipper, T_ONE, VoxelWalk, to_fixed};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
 use uavex_components::map::{
@@ -33,8 +33,10 @@ const STRIDE: [isize; 3] = [1, CHUNK_EDGE as isize, (CHUNK_EDGE * CHUNK_EDGE) as
 
 /// Mutable access to the map's chunks, by flat chunk index (see [`ChunkGrid::flat`]).
 pub trait ChunkAccess {
-    /// The chunk with flat index `flat` (at `coord`) and its statistics; a chunk of unknown
-    /// voxels with zero statistics is created if absent.
+    /// The chunk with flat index `flat` (at `coord`) and its statistics; if absent, a chunk of
+    /// unknown voxels with zero statistics is created, made by [`VoxelChunk::in_map`] (a plain
+    /// [`VoxelChunk::new`] would do too, at the cost of walking the map's border voxel by
+    /// voxel).
     fn chunk_mut(&mut self, flat: usize, coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums);
 
     /// Told once per visit of a chunk in which some voxel's log-odds changed.
@@ -71,8 +73,10 @@ pub struct ScanReport {
     pub changed_voxels: u64,
     /// Of the visits, those passed over in saturated cubes (no update needed).
     pub skipped_voxels: u64,
-    /// Saturated cubes crossed in one move, by size (indexed by [`super::cube::Cube`]).
+    /// Saturated cubes crossed in one move, by size (indexed by [`Cube`]).
     pub cubes_crossed: [u64; 3],
+    /// Chunks the walks entered or crossed (one per chunk per ray).
+    pub chunk_visits: u64,
 }
 
 /// A scan that cannot be integrated (refused before anything is written).
@@ -134,8 +138,9 @@ pub fn integrate_scan(
 
     // Pass 2: free space along every ray, skipping voxels this scan already updated.
     let miss_rule = rule(increments.miss);
+    let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
     for (end, hit) in ends() {
-        let Some(clip) = clip_segment(origin, end, config.key_min(), config.key_max()) else {
+        let Some(clip) = clipper.clip(end) else {
             continue;
         };
         let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
@@ -262,11 +267,41 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let [cx, cy, cz] = [mx * CURSOR_X, my * CURSOR_Y, mz * CURSOR_Z];
         let mut key = walk.key();
         let mut stop = false;
-        let skip_saturated = rule.delta <= 0;
+        // Saturated voxels stay unchanged by a non-positive increment only (a miss, always in
+        // practice).
+        let mut cubes_left = if rule.delta <= 0 {
+            CubeLimit::ANY
+        } else {
+            CubeLimit::NONE
+        };
         while visits > 0 && !stop {
             let coord = ChunkCoord::of_key(key);
             let flat = self.grid.flat_unchecked(coord);
             let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
+            self.report.chunk_visits += 1;
+            // A chunk saturated whole is crossed without entering it: no voxel, stamp or
+            // statistic of it is touched (the same move as `cross_saturated`'s chunk case).
+            if cubes_left.allows(Cube::Chunk) && chunk.saturation().full_bricks() == u64::MAX {
+                let local = (key & (CHUNK_EDGE - 1)).as_i64vec3().to_array();
+                let crossing = cross_cube::<{ CHUNK_EDGE as i64 }>(
+                    local,
+                    [mx, my, mz],
+                    [tx, ty, tz],
+                    [dtx, dty, dtz],
+                );
+                if crossing.face_time < t_safe {
+                    let passed = crossing.voxels_passed() as u64;
+                    debug_assert!(passed <= visits);
+                    visits -= passed;
+                    self.report.skipped_voxels += passed;
+                    self.report.cubes_crossed[Cube::Chunk as usize] += 1;
+                    [tx, ty, tz] = crossing.boundary_times;
+                    let [kx, ky, kz] = crossing.crossings;
+                    key += IVec3::new((kx * mx) as i32, (ky * my) as i32, (kz * mz) as i32);
+                    continue;
+                }
+                cubes_left.failed(Cube::Chunk);
+            }
             chunk.begin_scan(self.scan);
             let before = *stats;
             let (voxels, saturation) = chunk.voxels_and_saturation_mut();
@@ -279,7 +314,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 let index = cursor.index();
                 let brick = brick_of(index);
                 let full_bricks = saturation.full_bricks();
-                if skip_saturated && full_bricks >> brick & 1 == 1 {
+                if cubes_left.open() && full_bricks >> brick & 1 == 1 {
                     let crossing = cross_saturated(
                         full_bricks,
                         brick,
@@ -288,6 +323,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                         [tx, ty, tz],
                         [dtx, dty, dtz],
                         t_safe,
+                        &mut cubes_left,
                     );
                     if let Some((cube, crossing)) = crossing {
                         cubes[cube as usize] += 1;

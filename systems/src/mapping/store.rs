@@ -56,9 +56,12 @@ impl ChunkStore {
 
 impl ChunkAccess for ChunkStore {
     #[inline]
-    fn chunk_mut(&mut self, flat: usize, _coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums) {
-        let (chunk, stats) =
-            self.chunks[flat].get_or_insert_with(|| (VoxelChunk::new(), StatSums::default()));
+    fn chunk_mut(&mut self, flat: usize, coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums) {
+        let config = &self.config;
+        let (chunk, stats) = self.chunks[flat].get_or_insert_with(|| {
+            let chunk = VoxelChunk::in_map(coord, config.key_min(), config.key_max());
+            (chunk, StatSums::default())
+        });
         (chunk, stats)
     }
 

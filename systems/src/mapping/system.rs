@@ -86,6 +86,7 @@ pub fn integrate_scans(
     let grid = config.chunk_grid();
     scratch.slot_of.resize(grid.len(), NO_SLOT);
     let mut view = EcsChunks {
+        config: &config,
         slot_of: &mut scratch.slot_of,
         existing: Vec::with_capacity(scratch.wanted.len()),
         created: &mut scratch.created,
@@ -171,6 +172,7 @@ struct LentChunk<'w> {
 
 /// [`ChunkAccess`] over the chunks lent from the ECS plus those created during the run.
 struct EcsChunks<'a, 'w> {
+    config: &'a MapConfig,
     slot_of: &'a mut [u32],
     existing: Vec<LentChunk<'w>>,
     created: &'a mut Vec<NewChunk>,
@@ -216,7 +218,7 @@ impl ChunkAccess for EcsChunks<'_, '_> {
             self.created.push(NewChunk {
                 flat,
                 coord,
-                chunk: VoxelChunk::new(),
+                chunk: VoxelChunk::in_map(coord, self.config.key_min(), self.config.key_max()),
                 stats: StatSums::default(),
             });
         }

@@ -36,7 +36,10 @@ struct Mapper {
 
 impl Mapper {
     fn new() -> Self {
-        let config = config();
+        Self::with(config())
+    }
+
+    fn with(config: MapConfig) -> Self {
         Self {
             store: ChunkStore::new(&config),
             config,
@@ -435,8 +438,29 @@ fn floor_key(q: DVec3) -> IVec3 {
 /// The reference shares only the traversal (`for_each_key`, tested against sampling in `dda`).
 #[test]
 fn crossing_saturated_cubes_leaves_the_map_as_a_plain_update_would() {
-    let mut m = Mapper::new();
-    let config = m.config.clone();
+    crossing_leaves_the_map_as_a_plain_update_would(config());
+}
+
+/// The same in a map whose border does not fall on chunk faces (keys -31..=29 on each axis):
+/// the border chunks' voxels outside the map count as saturated, and rays reaching past the
+/// border are cut there, inside cubes that hold outside voxels.
+#[test]
+fn crossing_saturated_cubes_at_a_border_inside_chunks_leaves_the_map_as_a_plain_update_would() {
+    let config = MapConfig::new(&MapSettings {
+        bounds_min: DVec3::splat(-3.05),
+        bounds_max: DVec3::splat(2.95),
+        ..MapSettings::default()
+    })
+    .unwrap();
+    assert_eq!(
+        (config.key_min(), config.key_max()),
+        (IVec3::splat(-31), IVec3::splat(29))
+    );
+    crossing_leaves_the_map_as_a_plain_update_would(config);
+}
+
+fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
+    let mut m = Mapper::with(config.clone());
     let (min, max) = (i32::from(config.clamp_min()), i32::from(config.clamp_max()));
     let mut reference: std::collections::HashMap<[i32; 3], i16> = Default::default();
     let mut rng = ChaCha8Rng::seed_from_u64(23);

@@ -17,7 +17,9 @@
 //! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
 //! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
 //! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_LOOPS=n` replays the planning
-//! n more times (for `perf record`).
+//! n more times (for `perf record`); `DECISION_PAUSE_S=s` prints a line and waits `s` seconds
+//! between the mission and the replay (to switch a profiler on for the replay alone: under
+//! valgrind the mission takes an hour instrumented, a few minutes not).
 //!
 //! `cargo bench --bench decision` (a plain timed program, `harness = false`).
 
@@ -190,6 +192,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0);
+    let pause = std::env::var("DECISION_PAUSE_S")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .map(std::time::Duration::from_secs_f64);
     let mut digest_file = std::env::var("DECISION_DIGEST")
         .ok()
         .map(|p| std::fs::File::create(p).expect("a writable digest file"));
@@ -206,6 +212,13 @@ fn main() {
         let (outcome, _) = pool.install(|| sim.run_to_end());
         let snapshots = std::mem::take(&mut sim.world.resource_mut::<Snapshots>().0);
         drop(sim);
+        if let Some(pause) = pause {
+            // A profiler attached to the replay only (e.g. valgrind --instr-atstart=no, then
+            // `callgrind_control -i on` on this line) starts at the same point every run.
+            println!("seed {seed}: mission flown, replay in {pause:?}");
+            std::io::stdout().flush().expect("stdout flushed");
+            std::thread::sleep(pause);
+        }
 
         let (mut clustering, mut trajectories, mut energy, mut means, mut totals) =
             (vec![], vec![], vec![], vec![], vec![]);

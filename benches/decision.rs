@@ -52,6 +52,8 @@ use uavex_systems::mapping::MapReader;
 use uavex_systems::planning::{Traversability, TraversableGrid};
 use uavex_systems::trajectory::DynamicLimits;
 
+/// Replays of each part of each decision, the fastest kept (`DECISION_REPEATS` overrides it:
+/// 1 under callgrind, whose counts do not vary).
 const REPEATS: usize = 3;
 
 /// Everything one decision's planning needs, as the propose step sees it.
@@ -160,15 +162,20 @@ fn digest(planned: &[PlannedCandidate]) -> u64 {
 }
 
 fn fastest_ms<T>(mut f: impl FnMut() -> T) -> (f64, T) {
+    let repeats = std::env::var("DECISION_REPEATS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(REPEATS)
+        .max(1);
     let mut best = f64::INFINITY;
     let mut out = None;
-    for _ in 0..REPEATS {
+    for _ in 0..repeats {
         let started = Instant::now();
         let value = f();
         best = best.min(started.elapsed().as_secs_f64() * 1e3);
         out = Some(value);
     }
-    (best, out.expect("REPEATS > 0"))
+    (best, out.expect("at least one repeat"))
 }
 
 fn quantiles(mut v: Vec<f64>) -> (f64, f64, f64) {

@@ -226,14 +226,22 @@ mod tests {
                 let l = factor.l();
                 for i in 0..n {
                     for j in first[i]..=i {
-                        assert_eq!(band.l.get(i, j).to_bits(), l[(i, j)].to_bits(), "{n} {i} {j}");
+                        assert_eq!(
+                            band.l.get(i, j).to_bits(),
+                            l[(i, j)].to_bits(),
+                            "{n} {i} {j}"
+                        );
                     }
                 }
                 let want = factor.solve(&DVector::from_column_slice(&rhs));
                 let mut got = rhs.clone();
                 band.solve(&mut got);
                 for (g, w) in got.iter().zip(want.iter()) {
-                    assert_eq!(g.to_bits(), w.to_bits(), "n {n} width {width}: {got:?} {want:?}");
+                    assert_eq!(
+                        g.to_bits(),
+                        w.to_bits(),
+                        "n {n} width {width}: {got:?} {want:?}"
+                    );
                 }
             }
         }

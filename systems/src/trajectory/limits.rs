@@ -245,7 +245,11 @@ pub fn worst_ratio(
         let accel = Prepared::new(segment, 2);
         let (best, brackets) = accel.scan::<2>();
         worst = worst.max(acceleration(best));
-        pending.extend(brackets.into_iter().map(|b| (acceleration(b.bound), index, 2, b)));
+        pending.extend(
+            brackets
+                .into_iter()
+                .map(|b| (acceleration(b.bound), index, 2, b)),
+        );
         prepared.push([velocity, accel]);
     }
     pending.sort_by(|a, b| b.0.total_cmp(&a.0));

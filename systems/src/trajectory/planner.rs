@@ -65,12 +65,7 @@ impl DynamicLimits {
     /// The largest `max(v / vmax, sqrt(a / amax))` over `trajectory` when above `floor`
     /// ([`worst_ratio`]).
     fn worst_ratio(&self, trajectory: &PiecewisePolynomial, floor: f64) -> f64 {
-        worst_ratio(
-            trajectory,
-            self.max_velocity,
-            self.max_acceleration,
-            floor,
-        )
+        worst_ratio(trajectory, self.max_velocity, self.max_acceleration, floor)
     }
 
     fn check(&self) -> Result<(), PlanError> {

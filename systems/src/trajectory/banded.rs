@@ -82,8 +82,8 @@ pub struct BandCholesky {
 
 impl BandCholesky {
     /// `L L^T = a`, or `None` where nalgebra's `cholesky()` gives `None` (a pivot that is not
-    /// > 0). Per entry, the dense left-looking algorithm: `y = a_ij`, then
-    /// `y = -l_jk l_ik + y` for k ascending, then `l_jj = sqrt(y)` or `l_ij = y / l_jj`.
+    /// positive). Per entry, the dense left-looking algorithm: `y = a_ij`, then
+    /// `y += -l_jk l_ik` for k ascending, then `l_jj = sqrt(y)` or `l_ij = y / l_jj`.
     pub fn new(mut a: BandMatrix) -> Option<Self> {
         let n = a.len();
         for i in 0..n {
@@ -92,10 +92,10 @@ impl BandCholesky {
                 let mut y = a.get(i, j);
                 // l_ik = 0 for k < first[i], and first[j] <= first[i].
                 for k in row_first..j {
-                    y = -a.get(j, k) * a.get(i, k) + y;
+                    y += -a.get(j, k) * a.get(i, k);
                 }
                 let value = if j == i {
-                    if !(y > 0.0) {
+                    if y.is_nan() || y <= 0.0 {
                         return None;
                     }
                     y.sqrt()
@@ -129,7 +129,7 @@ impl BandCholesky {
                 y = 0.0;
             }
             for (i, z) in b.iter().enumerate().take(r).skip(f) {
-                y = -z * self.l.get(r, i) + y;
+                y += -z * self.l.get(r, i);
             }
             b[r] = y / self.l.get(r, r);
             signed_before[r + 1] = signed_before[r] || b[r].is_sign_negative();

@@ -17,7 +17,9 @@
 //! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
 //! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
 //! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_LOOPS=n` replays the planning
-//! n more times (for `perf record`).
+//! n more times (for `perf record`); `DECISION_PAUSE_S=s` prints a line and waits `s` seconds
+//! between the mission and the replay (to switch a profiler on for the replay alone: under
+//! valgrind the mission takes an hour instrumented, a few minutes not).
 //!
 //! `cargo bench --bench decision` (a plain timed program, `harness = false`).
 
@@ -50,6 +52,8 @@ use uavex_systems::mapping::MapReader;
 use uavex_systems::planning::{Traversability, TraversableGrid};
 use uavex_systems::trajectory::DynamicLimits;
 
+/// Replays of each part of each decision, the fastest kept (`DECISION_REPEATS` overrides it:
+/// 1 under callgrind, whose counts do not vary).
 const REPEATS: usize = 3;
 
 /// Everything one decision's planning needs, as the propose step sees it.
@@ -158,15 +162,20 @@ fn digest(planned: &[PlannedCandidate]) -> u64 {
 }
 
 fn fastest_ms<T>(mut f: impl FnMut() -> T) -> (f64, T) {
+    let repeats = std::env::var("DECISION_REPEATS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(REPEATS)
+        .max(1);
     let mut best = f64::INFINITY;
     let mut out = None;
-    for _ in 0..REPEATS {
+    for _ in 0..repeats {
         let started = Instant::now();
         let value = f();
         best = best.min(started.elapsed().as_secs_f64() * 1e3);
         out = Some(value);
     }
-    (best, out.expect("REPEATS > 0"))
+    (best, out.expect("at least one repeat"))
 }
 
 fn quantiles(mut v: Vec<f64>) -> (f64, f64, f64) {
@@ -190,6 +199,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0);
+    let pause = std::env::var("DECISION_PAUSE_S")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .map(std::time::Duration::from_secs_f64);
     let mut digest_file = std::env::var("DECISION_DIGEST")
         .ok()
         .map(|p| std::fs::File::create(p).expect("a writable digest file"));
@@ -206,6 +219,13 @@ fn main() {
         let (outcome, _) = pool.install(|| sim.run_to_end());
         let snapshots = std::mem::take(&mut sim.world.resource_mut::<Snapshots>().0);
         drop(sim);
+        if let Some(pause) = pause {
+            // A profiler attached to the replay only (e.g. valgrind --instr-atstart=no, then
+            // `callgrind_control -i on` on this line) starts at the same point every run.
+            println!("seed {seed}: mission flown, replay in {pause:?}");
+            std::io::stdout().flush().expect("stdout flushed");
+            std::thread::sleep(pause);
+        }
 
         let (mut clustering, mut trajectories, mut energy, mut means, mut totals) =
             (vec![], vec![], vec![], vec![], vec![]);

@@ -94,39 +94,178 @@ pub fn segment_peak(segment: &PolynomialSegment, order: usize) -> f64 {
     }
 }
 
-/// [`segment_peak`] for one order.
+/// [`segment_peak`] for one order: the grid's values and every bracketed maximum refined.
 fn peak<const ORDER: usize>(segment: &PolynomialSegment) -> f64 {
-    let (derivative, next) = (
-        Derivative::new(segment, ORDER),
-        Derivative::new(segment, ORDER + 1),
-    );
-    let slope = |tau: f64| {
-        let (d, next) = derivative.pair_at::<ORDER>(&next, tau);
-        (dot(&d, &d), dot(&d, &next))
-    };
-    let mut best: f64 = 0.0;
-    let mut previous = slope(0.0);
-    best = best.max(previous.0);
-    for i in 1..=GRID {
-        let tau = i as f64 / GRID as f64;
-        let current = slope(tau);
-        best = best.max(current.0);
-        // |d|^2 rising then falling: a maximum inside.
-        if previous.1 > 0.0 && current.1 < 0.0 {
-            let (mut lo, mut hi) = ((i - 1) as f64 / GRID as f64, tau);
-            for _ in 0..BISECTIONS {
-                let mid = 0.5 * (lo + hi);
-                if slope(mid).1 > 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            best = best.max(slope(0.5 * (lo + hi)).0);
-        }
-        previous = current;
+    let prepared = Prepared::new(segment, ORDER);
+    let (mut best, brackets) = prepared.scan::<ORDER>();
+    for bracket in &brackets {
+        best = best.max(prepared.refine::<ORDER>(bracket));
     }
     best.sqrt()
+}
+
+/// One derivative order of a segment ready for the peak search: its Horner coefficients, those
+/// of the next order, and what bounds it between two grid points.
+struct Prepared {
+    derivative: Derivative,
+    next: Derivative,
+    duration: f64,
+    /// Per axis, a bound on the second tau-derivative of this derivative over tau in [0, 1]
+    /// (sum of |coefficients|, in real-time units).
+    curvature: [f64; 3],
+    /// Per axis, a bound on the rounding of one evaluation (a generous multiple of the sum of
+    /// the |terms|).
+    rounding: [f64; 3],
+}
+
+/// A grid interval where `|d|^2` rises then falls, and a bound on `|d|^2` inside it.
+struct Bracket {
+    lo: f64,
+    hi: f64,
+    bound: f64,
+}
+
+impl Prepared {
+    fn new(segment: &PolynomialSegment, order: usize) -> Self {
+        let derivative = Derivative::new(segment, order);
+        let abs_sum = |order: usize, axis: usize| {
+            segment.coefficients[axis]
+                .iter()
+                .enumerate()
+                .skip(order)
+                .map(|(k, c)| falling(k, order) * c.abs())
+                .sum::<f64>()
+                * derivative.scale
+        };
+        Self {
+            next: Derivative::new(segment, order + 1),
+            duration: segment.duration,
+            curvature: std::array::from_fn(|axis| abs_sum(order + 2, axis)),
+            rounding: std::array::from_fn(|axis| 1e-9 * abs_sum(order, axis)),
+            derivative,
+        }
+    }
+
+    /// The derivative and the next order at `tau`.
+    #[inline(always)]
+    fn at<const ORDER: usize>(&self, tau: f64) -> ([f64; 3], [f64; 3]) {
+        self.derivative.pair_at::<ORDER>(&self.next, tau)
+    }
+
+    /// `|d|^2` and `d . d'` at `tau`.
+    #[inline(always)]
+    fn slope<const ORDER: usize>(&self, tau: f64) -> (f64, f64) {
+        let (d, next) = self.at::<ORDER>(tau);
+        (dot(&d, &d), dot(&d, &next))
+    }
+
+    /// The largest `|d|^2` on the grid (ends included) and the brackets of inner maxima.
+    fn scan<const ORDER: usize>(&self) -> (f64, Vec<Bracket>) {
+        let mut brackets = Vec::new();
+        let mut best: f64 = 0.0;
+        let mut previous_tau = 0.0;
+        let mut previous_values = self.at::<ORDER>(previous_tau);
+        let mut previous = (
+            dot(&previous_values.0, &previous_values.0),
+            dot(&previous_values.0, &previous_values.1),
+        );
+        best = best.max(previous.0);
+        for i in 1..=GRID {
+            let tau = i as f64 / GRID as f64;
+            let values = self.at::<ORDER>(tau);
+            let current = (dot(&values.0, &values.0), dot(&values.0, &values.1));
+            best = best.max(current.0);
+            // |d|^2 rising then falling: a maximum inside.
+            if previous.1 > 0.0 && current.1 < 0.0 {
+                brackets.push(Bracket {
+                    lo: previous_tau,
+                    hi: tau,
+                    bound: self.bound(previous_values, tau - previous_tau),
+                });
+            }
+            (previous_tau, previous_values, previous) = (tau, values, current);
+        }
+        (best, brackets)
+    }
+
+    /// A bound on `|d|^2` over `[tau, tau + width]`, from the values at `tau` (`d`, and `next`
+    /// = d' in real time): per axis |d| + w T |next| + w^2 / 2 max|d''|, plus rounding.
+    fn bound(&self, (d, next): ([f64; 3], [f64; 3]), width: f64) -> f64 {
+        let w = width * (1.0 + 1e-9);
+        let mut sum = 0.0;
+        for axis in 0..3 {
+            let reach = d[axis].abs()
+                + w * self.duration * next[axis].abs()
+                + 0.5 * w * w * self.curvature[axis]
+                + self.rounding[axis];
+            sum += reach * reach;
+        }
+        sum * (1.0 + 1e-9)
+    }
+
+    /// The bisected maximum of a bracket, as [`segment_peak`] has always found it.
+    fn refine<const ORDER: usize>(&self, bracket: &Bracket) -> f64 {
+        let (mut lo, mut hi) = (bracket.lo, bracket.hi);
+        for _ in 0..BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if self.slope::<ORDER>(mid).1 > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        self.slope::<ORDER>(0.5 * (lo + hi)).0
+    }
+}
+
+/// The largest excess ratio `max(v / vmax, sqrt(a / amax))` over the trajectory, the same
+/// number, bit for bit, as the largest over [`segment_peaks`], when it is above `floor`;
+/// otherwise a number <= `floor`.
+///
+/// Why not the peaks of every segment: the bisection of each grid bracket costs as much as
+/// the grid, and only the largest value decides (the ratio is monotonic in `|d|^2`). Every
+/// segment is scanned on the grid first; a bracket is then refined only if the bound on its
+/// inside could beat the ratio found so far (or `floor`), largest bound first.
+pub fn worst_ratio(
+    trajectory: &PiecewisePolynomial,
+    max_velocity: f64,
+    max_acceleration: f64,
+    floor: f64,
+) -> f64 {
+    let speed = |d2: f64| d2.sqrt() / max_velocity;
+    let acceleration = |d2: f64| (d2.sqrt() / max_acceleration).sqrt();
+    let mut worst: f64 = 0.0;
+    let mut prepared = Vec::with_capacity(trajectory.segments().len());
+    let mut pending = Vec::new();
+    for (index, segment) in trajectory.segments().iter().enumerate() {
+        let velocity = Prepared::new(segment, 1);
+        let (best, brackets) = velocity.scan::<1>();
+        worst = worst.max(speed(best));
+        pending.extend(brackets.into_iter().map(|b| (speed(b.bound), index, 1, b)));
+        let accel = Prepared::new(segment, 2);
+        let (best, brackets) = accel.scan::<2>();
+        worst = worst.max(acceleration(best));
+        pending.extend(
+            brackets
+                .into_iter()
+                .map(|b| (acceleration(b.bound), index, 2, b)),
+        );
+        prepared.push([velocity, accel]);
+    }
+    pending.sort_by(|a, b| b.0.total_cmp(&a.0));
+    for (bound, index, order, bracket) in &pending {
+        if *bound <= worst.max(floor) {
+            break;
+        }
+        let [velocity, accel] = &prepared[*index];
+        let ratio = if *order == 1 {
+            speed(velocity.refine::<1>(bracket))
+        } else {
+            acceleration(accel.refine::<2>(bracket))
+        };
+        worst = worst.max(ratio);
+    }
+    worst
 }
 
 /// Peak speed and peak acceleration of each segment.
@@ -200,6 +339,48 @@ mod tests {
                         assert_eq!(d[axis].to_bits(), want[order].to_bits(), "{order} {tau}");
                         assert_eq!(next[axis].to_bits(), want[order + 1].to_bits(), "{tau}");
                     }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn worst_ratio_is_the_largest_segment_ratio_bit_for_bit() {
+        // Minimum-snap tours through random points (so that segments have several brackets
+        // of very different heights), at random limits: the pruned search must return the
+        // plain maximum over every segment's peaks, and with a floor, a value on the same
+        // side of it.
+        use crate::trajectory::{Waypoint, min_snap_with_durations};
+        use glam::DVec3;
+        use uavex_components::trajectory::TrajectoryPoint;
+        let mut seed = 0x853c_49e6_748f_ea9bu64;
+        let mut next = || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..40 {
+            let count = 1 + (next() * 12.0) as usize;
+            let waypoints: Vec<Waypoint> = (0..count)
+                .map(|_| Waypoint::new(DVec3::new(next() * 8.0, next() * 8.0, next() * 2.0)))
+                .collect();
+            let durations: Vec<f64> = (0..count).map(|_| 0.2 + 3.0 * next()).collect();
+            let start = TrajectoryPoint::at_rest(DVec3::ZERO, 0.0);
+            let trajectory = min_snap_with_durations(&start, &waypoints, &durations).unwrap();
+            let (vmax, amax) = (0.5 + 4.0 * next(), 0.5 + 6.0 * next());
+            let plain = segment_peaks(&trajectory)
+                .into_iter()
+                .map(|(v, a)| (v / vmax).max((a / amax).sqrt()))
+                .fold(0.0, f64::max);
+            let pruned = worst_ratio(&trajectory, vmax, amax, 0.0);
+            assert_eq!(pruned.to_bits(), plain.to_bits(), "{pruned} {plain}");
+            for floor in [0.5 * plain, plain, 2.0 * plain] {
+                let above = worst_ratio(&trajectory, vmax, amax, floor);
+                if plain > floor {
+                    assert_eq!(above.to_bits(), plain.to_bits());
+                } else {
+                    assert!(above <= floor, "{above} {floor}");
                 }
             }
         }

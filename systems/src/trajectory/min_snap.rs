@@ -16,7 +16,8 @@
 //! segments of very different durations well conditioned.
 
 use super::PlanError;
-use nalgebra::{DMatrix, DVector, SMatrix};
+use super::banded::{BandCholesky, BandMatrix};
+use nalgebra::SMatrix;
 use std::sync::OnceLock;
 use uavex_components::trajectory::{POLYNOMIAL_COEFFICIENTS, PolynomialSegment};
 
@@ -79,72 +80,145 @@ pub fn solve_joint_derivatives(
     durations: &[f64],
     constraints: &JointConstraints,
 ) -> Result<Vec<[f64; ORDERS]>, PlanError> {
-    let segments = durations.len();
-    let joints = segments + 1;
-    if constraints.values.len() != joints {
+    let mut solved = solve_outputs(durations, std::slice::from_ref(constraints))?;
+    Ok(solved.pop().expect("one output"))
+}
+
+/// [`solve_joint_derivatives`] for several outputs over the same durations, in order (the
+/// first error returned). The snap form depends on the durations only, and its free block on
+/// which derivatives are free: outputs with the same free set (x, y and z always; yaw when
+/// every heading is given) share one factorisation.
+pub fn solve_outputs(
+    durations: &[f64],
+    outputs: &[JointConstraints],
+) -> Result<Vec<Vec<[f64; ORDERS]>>, PlanError> {
+    let joints = durations.len() + 1;
+    if let Some(c) = outputs.iter().find(|c| c.values.len() != joints) {
         return Err(PlanError::Internal(format!(
-            "{} joint constraints for {segments} segments",
-            constraints.values.len()
+            "{} joint constraints for {} segments",
+            c.values.len(),
+            durations.len()
         )));
     }
-    let (_, h) = constant_matrices();
-    let size = ORDERS * joints;
-    // R: sum over segments of T^-7 S H S on the segment's 8 joint variables.
-    let mut r = DMatrix::<f64>::zeros(size, size);
-    for (i, &duration) in durations.iter().enumerate() {
-        let s = tau_scale(duration);
-        let weight = duration.powi(-7);
-        for a in 0..N {
-            for b in 0..N {
-                r[(ORDERS * i + a, ORDERS * i + b)] += weight * s[a] * h[(a, b)] * s[b];
-            }
-        }
-    }
-    let mut fixed = Vec::new();
-    let mut free = Vec::new();
-    let mut values = vec![0.0; size];
-    for (joint, orders) in constraints.values.iter().enumerate() {
-        for (order, value) in orders.iter().enumerate() {
-            let index = ORDERS * joint + order;
-            match value {
-                Some(v) => {
-                    if !v.is_finite() {
-                        return Err(PlanError::NonFinite(format!(
-                            "derivative {order} at waypoint {joint}"
-                        )));
+    let form = SnapForm::new(durations);
+    let mut factor: Option<FreeBlock> = None;
+    let mut solved = Vec::with_capacity(outputs.len());
+    for constraints in outputs {
+        let mut free = Vec::new();
+        let mut fixed = Vec::new();
+        let mut values = vec![0.0; ORDERS * joints];
+        for (joint, orders) in constraints.values.iter().enumerate() {
+            for (order, value) in orders.iter().enumerate() {
+                let index = ORDERS * joint + order;
+                match value {
+                    Some(v) => {
+                        if !v.is_finite() {
+                            return Err(PlanError::NonFinite(format!(
+                                "derivative {order} at waypoint {joint}"
+                            )));
+                        }
+                        values[index] = *v;
+                        fixed.push(index);
                     }
-                    values[index] = *v;
-                    fixed.push(index);
+                    None => free.push(index),
                 }
-                None => free.push(index),
             }
         }
-    }
-    if !free.is_empty() {
-        // R_PP x = -R_PF d_F, with R_PP scaled to unit diagonal: D R_PP D y = -D R_PF d_F.
-        let scale: Vec<f64> = free.iter().map(|&i| 1.0 / r[(i, i)].sqrt()).collect();
-        let rpp = DMatrix::from_fn(free.len(), free.len(), |a, b| {
-            scale[a] * r[(free[a], free[b])] * scale[b]
-        });
-        let rhs = DVector::from_fn(free.len(), |a, _| {
-            -scale[a]
-                * fixed
-                    .iter()
-                    .map(|&f| r[(free[a], f)] * values[f])
-                    .sum::<f64>()
-        });
-        let cholesky = rpp.cholesky().ok_or(PlanError::Singular)?;
-        let y = cholesky.solve(&rhs);
-        for (a, &index) in free.iter().enumerate() {
-            values[index] = scale[a] * y[a];
+        if !free.is_empty() {
+            if factor.as_ref().is_none_or(|f| f.free != free) {
+                factor = Some(FreeBlock::new(&form, free)?);
+            }
+            let block = factor.as_ref().expect("factorised above");
+            // R_PP x = -R_PF d_F, with R_PP scaled to unit diagonal: D R_PP D y = -D R_PF d_F.
+            let mut y: Vec<f64> = (0..block.free.len())
+                .map(|a| {
+                    -block.scale[a]
+                        * fixed
+                            .iter()
+                            .map(|&f| form.get(block.free[a], f) * values[f])
+                            .sum::<f64>()
+                })
+                .collect();
+            block.cholesky.solve(&mut y);
+            for (a, &index) in block.free.iter().enumerate() {
+                values[index] = block.scale[a] * y[a];
+            }
         }
+        if values.iter().any(|v| !v.is_finite()) {
+            return Err(PlanError::Singular);
+        }
+        solved.push(
+            (0..joints)
+                .map(|j| std::array::from_fn(|o| values[ORDERS * j + o]))
+                .collect(),
+        );
     }
-    if values.iter().any(|v| !v.is_finite()) {
-        return Err(PlanError::Singular);
+    Ok(solved)
+}
+
+/// Half-width of the snap form's band: a segment couples the 8 derivatives of its two joints.
+const BAND: usize = 2 * ORDERS - 1;
+
+/// The snap form `R` (the sum over segments of `T^-7 S H S` on each segment's 8 joint
+/// variables), stored by its band: `band[p][q + BAND - p]` for |p - q| <= BAND, zero elsewhere.
+/// Both triangles are kept: `H` is symmetric only up to rounding, and the dense code this
+/// replaces read `R[p][q]` for the right-hand side and the lower triangle for the factor.
+struct SnapForm {
+    band: Vec<[f64; 2 * BAND + 1]>,
+}
+
+impl SnapForm {
+    fn new(durations: &[f64]) -> Self {
+        let (_, h) = constant_matrices();
+        let mut band = vec![[0.0; 2 * BAND + 1]; ORDERS * (durations.len() + 1)];
+        for (i, &duration) in durations.iter().enumerate() {
+            let s = tau_scale(duration);
+            let weight = duration.powi(-7);
+            for a in 0..N {
+                for b in 0..N {
+                    band[ORDERS * i + a][b + BAND - a] += weight * s[a] * h[(a, b)] * s[b];
+                }
+            }
+        }
+        Self { band }
     }
-    Ok((0..joints)
-        .map(|j| std::array::from_fn(|o| values[ORDERS * j + o]))
-        .collect())
+
+    #[inline]
+    fn get(&self, p: usize, q: usize) -> f64 {
+        if p.abs_diff(q) > BAND {
+            return 0.0;
+        }
+        self.band[p][q + BAND - p]
+    }
+}
+
+/// The free block `R_PP` of one free set, scaled to unit diagonal and factorised.
+struct FreeBlock {
+    free: Vec<usize>,
+    scale: Vec<f64>,
+    cholesky: BandCholesky,
+}
+
+impl FreeBlock {
+    fn new(form: &SnapForm, free: Vec<usize>) -> Result<Self, PlanError> {
+        let scale: Vec<f64> = free.iter().map(|&i| 1.0 / form.get(i, i).sqrt()).collect();
+        // Free variables further apart than the band never share a segment.
+        let first: Vec<usize> = (0..free.len())
+            .map(|a| free.partition_point(|&q| q + BAND < free[a]))
+            .collect();
+        let mut block = BandMatrix::zeros(first);
+        for a in 0..free.len() {
+            for b in block.first(a)..=a {
+                block.set(a, b, scale[a] * form.get(free[a], free[b]) * scale[b]);
+            }
+        }
+        let cholesky = BandCholesky::new(block).ok_or(PlanError::Singular)?;
+        Ok(Self {
+            free,
+            scale,
+            cholesky,
+        })
+    }
 }
 
 /// The tau-polynomial coefficients of one segment from its boundary derivatives (real time).

@@ -3,6 +3,7 @@
 //! predicate, and analytic references (circle, figure-eight) for controller studies.
 
 pub mod analytic;
+mod banded;
 pub mod collision;
 pub mod limits;
 pub mod min_snap;

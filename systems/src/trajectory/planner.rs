@@ -17,8 +17,8 @@
 
 use super::PlanError;
 use super::collision::first_blocked;
-use super::limits::segment_peaks;
-use super::min_snap::{JointConstraints, build_segments, solve_joint_derivatives};
+use super::limits::worst_ratio;
+use super::min_snap::{JointConstraints, build_segments, solve_joint_derivatives, solve_outputs};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 use uavex_components::airframe::Airframe;
@@ -62,6 +62,12 @@ impl DynamicLimits {
         }
     }
 
+    /// The largest `max(v / vmax, sqrt(a / amax))` over `trajectory` when above `floor`
+    /// ([`worst_ratio`]).
+    fn worst_ratio(&self, trajectory: &PiecewisePolynomial, floor: f64) -> f64 {
+        worst_ratio(trajectory, self.max_velocity, self.max_acceleration, floor)
+    }
+
     fn check(&self) -> Result<(), PlanError> {
         for (name, value) in [
             ("max_velocity", self.max_velocity),
@@ -99,19 +105,14 @@ pub fn plan_min_snap(
     }
     let yaws = unwrapped_yaws(start.yaw, waypoints);
     let mut durations = initial_durations(start, waypoints, &yaws, limits)?;
-    let ratios = |trajectory: &PiecewisePolynomial| -> Vec<f64> {
-        segment_peaks(trajectory)
-            .into_iter()
-            .map(|(v, a)| (v / limits.max_velocity).max((a / limits.max_acceleration).sqrt()))
-            .collect()
-    };
     for _ in 0..MAX_ROUNDS {
-        let trajectory = solve_with_durations(start, waypoints, &yaws, &durations)?;
-        let worst = ratios(&trajectory).into_iter().fold(0.0, f64::max);
+        let mut outputs = solve_position(start, waypoints, &durations)?;
+        let worst = limits.worst_ratio(&trajectory_of(&durations, &outputs)?, 0.0);
         if worst <= 1.0 {
-            return Ok(
-                tighten(start, waypoints, &yaws, &durations, worst, &ratios).unwrap_or(trajectory)
-            );
+            return match tighten(start, waypoints, &yaws, &durations, worst, limits) {
+                Some(tightened) => Ok(tightened),
+                None => with_yaw(start, &yaws, &durations, &mut outputs),
+            };
         }
         durations.iter_mut().for_each(|d| *d *= worst * MARGIN);
     }
@@ -126,17 +127,15 @@ fn tighten(
     yaws: &[Option<f64>],
     durations: &[f64],
     worst: f64,
-    ratios: &dyn Fn(&PiecewisePolynomial) -> Vec<f64>,
+    limits: &DynamicLimits,
 ) -> Option<PiecewisePolynomial> {
     if worst >= 1.0 / MARGIN || worst <= 0.0 {
         return None;
     }
     let scaled: Vec<f64> = durations.iter().map(|d| d * worst * MARGIN).collect();
-    let trajectory = solve_with_durations(start, waypoints, yaws, &scaled).ok()?;
-    ratios(&trajectory)
-        .iter()
-        .all(|&r| r <= 1.0)
-        .then_some(trajectory)
+    let mut outputs = solve_position(start, waypoints, &scaled).ok()?;
+    let within = limits.worst_ratio(&trajectory_of(&scaled, &outputs).ok()?, 1.0) <= 1.0;
+    within.then(|| with_yaw(start, yaws, &scaled, &mut outputs).ok())?
 }
 
 /// Minimum-snap trajectory with given segment durations (no limits enforced).
@@ -280,17 +279,29 @@ fn initial_durations(
     Ok(durations)
 }
 
+/// The minimum-snap trajectory for the given durations, headings included.
 fn solve_with_durations(
     start: &TrajectoryPoint,
     waypoints: &[Waypoint],
     yaws: &[Option<f64>],
     durations: &[f64],
 ) -> Result<PiecewisePolynomial, PlanError> {
+    let mut outputs = solve_position(start, waypoints, durations)?;
+    with_yaw(start, yaws, durations, &mut outputs)
+}
+
+/// The joint derivatives of x, y and z for the given durations (one factorisation serves the
+/// three), yaw left at zero: the limits and the collision checks read positions only, so the
+/// re-timing rounds need not solve the heading.
+fn solve_position(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    durations: &[f64],
+) -> Result<[Vec<[f64; 4]>; 4], PlanError> {
     let last = waypoints.len();
-    let mut outputs: [Vec<[f64; 4]>; 4] = Default::default();
-    for (axis, output) in outputs.iter_mut().enumerate() {
-        let mut values = Vec::with_capacity(last + 1);
-        if axis < 3 {
+    let axes: Vec<JointConstraints> = (0..3)
+        .map(|axis| {
+            let mut values = Vec::with_capacity(last + 1);
             values.push([
                 Some(start.position[axis]),
                 Some(start.velocity[axis]),
@@ -301,19 +312,42 @@ fn solve_with_durations(
                 let at_rest = if i + 1 == last { Some(0.0) } else { None };
                 values.push([Some(w.position[axis]), at_rest, at_rest, at_rest]);
             }
-        } else {
-            values.push([
-                Some(start.yaw),
-                Some(start.yaw_rate),
-                Some(start.yaw_acceleration),
-                Some(0.0),
-            ]);
-            for (i, yaw) in yaws.iter().enumerate() {
-                let at_rest = if i + 1 == last { Some(0.0) } else { None };
-                values.push([*yaw, at_rest, at_rest, at_rest]);
-            }
-        }
-        *output = solve_joint_derivatives(durations, &JointConstraints { values })?;
+            JointConstraints { values }
+        })
+        .collect();
+    let [x, y, z]: [Vec<[f64; 4]>; 3] = solve_outputs(durations, &axes)?
+        .try_into()
+        .expect("three axes solved");
+    Ok([x, y, z, vec![[0.0; 4]; last + 1]])
+}
+
+/// Fills in the heading of [`solve_position`]'s outputs and builds the trajectory.
+fn with_yaw(
+    start: &TrajectoryPoint,
+    yaws: &[Option<f64>],
+    durations: &[f64],
+    outputs: &mut [Vec<[f64; 4]>; 4],
+) -> Result<PiecewisePolynomial, PlanError> {
+    let last = yaws.len();
+    let mut values = Vec::with_capacity(last + 1);
+    values.push([
+        Some(start.yaw),
+        Some(start.yaw_rate),
+        Some(start.yaw_acceleration),
+        Some(0.0),
+    ]);
+    for (i, yaw) in yaws.iter().enumerate() {
+        let at_rest = if i + 1 == last { Some(0.0) } else { None };
+        values.push([*yaw, at_rest, at_rest, at_rest]);
     }
-    PiecewisePolynomial::new(build_segments(durations, &outputs)).map_err(PlanError::Internal)
+    outputs[3] = solve_joint_derivatives(durations, &JointConstraints { values })?;
+    trajectory_of(durations, outputs)
+}
+
+/// The trajectory of the given joint derivatives.
+fn trajectory_of(
+    durations: &[f64],
+    outputs: &[Vec<[f64; 4]>; 4],
+) -> Result<PiecewisePolynomial, PlanError> {
+    PiecewisePolynomial::new(build_segments(durations, outputs)).map_err(PlanError::Internal)
 }

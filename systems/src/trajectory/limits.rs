@@ -299,17 +299,22 @@ mod tests {
         assert!((segment_peak(&segment, 2) - expected).abs() < 1e-9);
     }
 
+    /// A xorshift stream of numbers in [0, 1): reproducible inputs without a generator crate.
+    fn unit_stream(mut seed: u64) -> impl FnMut() -> f64 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        }
+    }
+
     #[test]
     fn prepared_derivatives_match_the_segment_bit_for_bit() {
         // Odd durations and coefficients of mixed sizes and signs: any change in the order of
         // operations would show in the last bits.
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut unit = unit_stream(0x2545_f491_4f6c_dd1d);
+        let mut next = || unit() * 2.0 - 1.0;
         for duration in [0.05, 0.37, 1.0, 2.9, 13.7] {
             let mut coefficients = [[0.0; N]; 4];
             for output in &mut coefficients {
@@ -353,13 +358,7 @@ mod tests {
         use crate::trajectory::{Waypoint, min_snap_with_durations};
         use glam::DVec3;
         use uavex_components::trajectory::TrajectoryPoint;
-        let mut seed = 0x853c_49e6_748f_ea9bu64;
-        let mut next = || {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut next = unit_stream(0x853c_49e6_748f_ea9b);
         for _ in 0..40 {
             let count = 1 + (next() * 12.0) as usize;
             let waypoints: Vec<Waypoint> = (0..count)

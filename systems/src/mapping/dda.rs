@@ -264,15 +264,35 @@ impl VoxelWalk {
 /// including the end key: the plain form of the traversal for callers outside the map update
 /// (line-of-sight checks, tests).
 pub fn for_each_key(start: DVec3, end: DVec3, lo: IVec3, hi: IVec3, mut visit: impl FnMut(IVec3)) {
+    all_keys(start, end, lo, hi, |key| {
+        visit(key);
+        true
+    });
+}
+
+/// Whether `test` holds for every key [`for_each_key`] visits, stopping at the first that
+/// fails (a line of sight is decided at its first blocked voxel).
+pub fn all_keys(
+    start: DVec3,
+    end: DVec3,
+    lo: IVec3,
+    hi: IVec3,
+    mut test: impl FnMut(IVec3) -> bool,
+) -> bool {
     let Some(clip) = clip_segment(start, end, lo, hi) else {
-        return;
+        return true;
     };
     let mut walk = VoxelWalk::new(start, end, clip.start_key, clip.end_key);
-    visit(walk.key());
+    if !test(walk.key()) {
+        return false;
+    }
     for _ in 0..walk.steps_left() {
         walk.advance();
-        visit(walk.key());
+        if !test(walk.key()) {
+            return false;
+        }
     }
+    true
 }
 
 #[cfg(test)]

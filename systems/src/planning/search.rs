@@ -18,6 +18,7 @@
 use super::lattice::Lattice;
 use super::traversable::TraversableGrid;
 use glam::{DVec3, IVec3};
+use std::cell::RefCell;
 
 /// How far (m) a blocked start may be moved to reach the lattice (the trajectory may leave it
 /// through untraversable space for this far, see `super::check`).
@@ -51,9 +52,20 @@ fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint>
     let traversable = grid.is_traversable_point(point);
     let home = Lattice::cell_of_key(grid.key_of(point));
     let n = (radius / (2.0 * resolution)).ceil() as i32 + 1;
+    // Planes and rows of cells whose centres all lie farther than `radius` (with a margin for
+    // rounding) hold no candidate and are skipped whole.
+    let beyond = radius * radius * (1.0 + 1e-9);
+    let offset = |d: IVec3| lattice.centre(home + d, resolution) - point;
     let mut candidates = Vec::new();
     for dz in -n..=n {
+        let z2 = offset(IVec3::Z * dz).z.powi(2);
+        if z2 > beyond {
+            continue;
+        }
         for dy in -n..=n {
+            if z2 + offset(IVec3::Y * dy).y.powi(2) > beyond {
+                continue;
+            }
             for dx in -n..=n {
                 let cell = home + IVec3::new(dx, dy, dz);
                 let Some(index) = lattice.index(cell) else {
@@ -70,15 +82,25 @@ fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint>
             }
         }
     }
-    candidates.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-    candidates
-        .into_iter()
-        .find(|&(_, _, centre)| !traversable || grid.line_of_sight(point, centre))
-        .map(|(_, cell, _)| Endpoint {
-            point,
-            cell,
-            traversable,
-        })
+    // The nearest candidate first (by distance, then index) that the point sees. The first
+    // is nearly always taken, so candidates are picked by selection rather than sorted.
+    while !candidates.is_empty() {
+        let nearest = (0..candidates.len())
+            .min_by(|&a, &b| {
+                let (a, b) = (&candidates[a], &candidates[b]);
+                a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
+            })
+            .expect("candidates left");
+        let (_, cell, centre) = candidates.swap_remove(nearest);
+        if !traversable || grid.line_of_sight(point, centre) {
+            return Some(Endpoint {
+                point,
+                cell,
+                traversable,
+            });
+        }
+    }
+    None
 }
 
 /// Appends `p`, merging it with the last point when closer than [`MIN_POINT_SEPARATION_M`]
@@ -110,12 +132,12 @@ fn assemble(grid: &TraversableGrid, from: &Endpoint, cells: &[usize], to: &Endpo
     path
 }
 
-/// Cells from the start to `goal` by following `parent`.
-fn trace(parent: &[u32], goal: usize) -> Vec<usize> {
+/// Cells from the start to `goal` by following the parents of `nodes`.
+fn trace(nodes: &Nodes, goal: usize) -> Vec<usize> {
     let mut cells = vec![goal];
     let mut at = goal;
-    while parent[at] != NONE {
-        at = parent[at] as usize;
+    while nodes.parent(at) != NONE {
+        at = nodes.parent(at) as usize;
         cells.push(at);
     }
     cells.reverse();
@@ -144,6 +166,15 @@ impl BucketQueue {
         }
     }
 
+    /// Empties the queue, keeping the buckets' memory.
+    fn reset(&mut self, current: u64) {
+        if self.len > 0 {
+            self.buckets.iter_mut().for_each(Vec::clear);
+        }
+        self.current = current;
+        self.len = 0;
+    }
+
     #[inline]
     fn push(&mut self, key: u64, node: usize) {
         self.buckets[key as usize % BUCKETS].push(node as u32);
@@ -165,29 +196,111 @@ impl BucketQueue {
     }
 }
 
-/// The state of one search over the lattice.
-struct Search {
-    cost: Vec<u64>,
-    parent: Vec<u32>,
-    closed: Vec<bool>,
+/// A cell's state in a search: its best cost so far and the cell it came from, valid only
+/// while `mark` is the search's (see [`Nodes`]).
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    cost: u64,
+    parent: u32,
+    mark: u32,
+}
+
+/// The state of every lattice cell, kept from one search to the next on each thread: a search
+/// begins by taking two new marks (reached, closed) instead of clearing lattice-sized arrays,
+/// which took longer than a short search itself (the local planner's A* expands a few
+/// hundred cells of a lattice of ~200,000). Cost, parent and mark sit together: a relaxation
+/// reads one cache line.
+struct Nodes {
+    nodes: Vec<Node>,
+    /// The mark of cells reached by the current search; `reached + 1` marks closed ones.
+    reached: u32,
+}
+
+impl Nodes {
+    const UNSEEN: Node = Node {
+        cost: u64::MAX,
+        parent: NONE,
+        mark: 0,
+    };
+
+    /// Starts a search over `len` cells: none reached.
+    fn begin(&mut self, len: usize) {
+        if self.nodes.len() != len || self.reached >= u32::MAX - 2 {
+            self.nodes.clear();
+            self.nodes.resize(len, Self::UNSEEN);
+            self.reached = 0;
+        }
+        self.reached += 2;
+    }
+
+    #[inline]
+    fn cost(&self, cell: usize) -> u64 {
+        let node = self.nodes[cell];
+        if node.mark >= self.reached {
+            node.cost
+        } else {
+            u64::MAX
+        }
+    }
+
+    #[inline]
+    fn parent(&self, cell: usize) -> u32 {
+        let node = self.nodes[cell];
+        if node.mark >= self.reached {
+            node.parent
+        } else {
+            NONE
+        }
+    }
+
+    #[inline]
+    fn is_closed(&self, cell: usize) -> bool {
+        self.nodes[cell].mark == self.reached + 1
+    }
+
+    #[inline]
+    fn close(&mut self, cell: usize) {
+        self.nodes[cell].mark = self.reached + 1;
+    }
+
+    #[inline]
+    fn reach(&mut self, cell: usize, cost: u64, parent: usize) {
+        self.nodes[cell] = Node {
+            cost,
+            parent: parent as u32,
+            mark: self.reached,
+        };
+    }
+}
+
+/// What a thread keeps between searches.
+struct Scratch {
+    nodes: Nodes,
+    queue: BucketQueue,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch {
+        nodes: Nodes {
+            nodes: Vec::new(),
+            reached: 0,
+        },
+        queue: BucketQueue::new(),
+    });
 }
 
 /// Best-first search from `start` (Dijkstra, or with `ASTAR` A* toward `target` with the octile
 /// heuristic), calling `settled` on every cell as it is closed (in order of cost) until it
-/// returns true, the reachable space is exhausted, or `max_expansions` cells were expanded.
-fn explore<const ASTAR: bool>(
+/// returns true, the reachable space is exhausted, or `max_expansions` cells were expanded;
+/// then `finish` reads the cells' final state.
+fn explore<const ASTAR: bool, R>(
     lattice: &Lattice,
     start: usize,
     target: IVec3,
     max_expansions: usize,
     mut settled: impl FnMut(usize) -> bool,
-) -> Search {
-    let n = lattice.len();
-    let mut search = Search {
-        cost: vec![u64::MAX; n],
-        parent: vec![NONE; n],
-        closed: vec![false; n],
-    };
+    finish: impl FnOnce(&Nodes) -> R,
+) -> R {
     let heuristic = |cell: IVec3| {
         if ASTAR {
             Lattice::heuristic(cell, target)
@@ -195,46 +308,47 @@ fn explore<const ASTAR: bool>(
             0
         }
     };
-    let mut queue = BucketQueue::new();
-    search.cost[start] = 0;
-    let start_cell = lattice.cell(start);
-    queue.current = heuristic(start_cell);
-    queue.push(queue.current, start);
-    let mut expansions = 0usize;
-    while let Some(index) = queue.pop() {
-        if search.closed[index] {
-            continue;
-        }
-        search.closed[index] = true;
-        if settled(index) {
-            break;
-        }
-        expansions += 1;
-        if expansions > max_expansions {
-            break;
-        }
-        let g = search.cost[index];
-        let cell = if ASTAR {
-            lattice.cell(index)
-        } else {
-            IVec3::ZERO
-        };
-        let open = lattice.open_neighbours(index);
-        for mv in lattice.moves() {
-            if open & mv.box_mask != mv.box_mask {
+    SCRATCH.with_borrow_mut(|Scratch { nodes, queue }| {
+        nodes.begin(lattice.len());
+        nodes.reach(start, 0, NONE as usize);
+        let start_cell = lattice.cell(start);
+        queue.reset(heuristic(start_cell));
+        queue.push(queue.current, start);
+        let mut expansions = 0usize;
+        while let Some(index) = queue.pop() {
+            if nodes.is_closed(index) {
                 continue;
             }
-            let next = index.wrapping_add_signed(mv.offset);
-            let g_next = g + mv.cost;
-            // A closed cell already has a cost <= g (consistent heuristic): no closed check.
-            if g_next < search.cost[next] {
-                search.cost[next] = g_next;
-                search.parent[next] = index as u32;
-                queue.push(g_next + heuristic(cell + mv.delta), next);
+            nodes.close(index);
+            if settled(index) {
+                break;
+            }
+            expansions += 1;
+            if expansions > max_expansions {
+                break;
+            }
+            let g = nodes.cost(index);
+            let cell = if ASTAR {
+                lattice.cell(index)
+            } else {
+                IVec3::ZERO
+            };
+            let open = lattice.open_neighbours(index);
+            for mv in lattice.moves() {
+                if open & mv.box_mask != mv.box_mask {
+                    continue;
+                }
+                let next = index.wrapping_add_signed(mv.offset);
+                let g_next = g + mv.cost;
+                // A closed cell already has a cost <= g (consistent heuristic): no closed check.
+                if g_next < nodes.cost(next) {
+                    nodes.reach(next, g_next, index);
+                    queue.push(g_next + heuristic(cell + mv.delta), next);
+                }
             }
         }
-    }
-    search
+        finish(nodes)
+    })
 }
 
 /// Shortest path (A*, 26-connected, Euclidean costs, octile heuristic, which is admissible and
@@ -251,13 +365,15 @@ pub fn find_path(
     let goal = attach(grid, to, GOAL_SNAP_RADIUS_M)?;
     let lattice = grid.lattice();
     let target = lattice.cell(goal.cell);
-    let search = explore::<true>(lattice, start.cell, target, max_expansions, |cell| {
-        cell == goal.cell
-    });
-    search.closed[goal.cell].then(|| {
-        let cells = trace(&search.parent, goal.cell);
-        assemble(grid, &start, &cells, &goal)
-    })
+    let cells = explore::<true, _>(
+        lattice,
+        start.cell,
+        target,
+        max_expansions,
+        |cell| cell == goal.cell,
+        |nodes| nodes.is_closed(goal.cell).then(|| trace(nodes, goal.cell)),
+    )?;
+    Some(assemble(grid, &start, &cells, &goal))
 }
 
 /// Shortest paths from `from` to every goal with one Dijkstra search, which stops when every
@@ -285,7 +401,7 @@ pub fn find_paths(
         return result;
     }
     let mut remaining = targets.len();
-    let search = explore::<false>(
+    let cells: Vec<Option<Vec<usize>>> = explore::<false, _>(
         grid.lattice(),
         start.cell,
         IVec3::ZERO,
@@ -296,17 +412,18 @@ pub fn find_paths(
             }
             remaining == 0
         },
+        |nodes| {
+            ends.iter()
+                .map(|end| {
+                    let end = end.as_ref()?;
+                    nodes.is_closed(end.cell).then(|| trace(nodes, end.cell))
+                })
+                .collect()
+        },
     );
-    for (slot, end) in result.iter_mut().zip(&ends) {
-        if let Some(end) = end
-            && search.closed[end.cell]
-        {
-            *slot = Some(assemble(
-                grid,
-                &start,
-                &trace(&search.parent, end.cell),
-                end,
-            ));
+    for ((slot, end), cells) in result.iter_mut().zip(&ends).zip(cells) {
+        if let (Some(end), Some(cells)) = (end, cells) {
+            *slot = Some(assemble(grid, &start, &cells, end));
         }
     }
     result

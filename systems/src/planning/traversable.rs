@@ -513,11 +513,9 @@ impl TraversableGrid {
             return false;
         }
         let (ua, ub) = (a / self.resolution, b / self.resolution);
-        let mut clear = true;
-        crate::mapping::dda::for_each_key(ua, ub, self.key_min, self.key_max, |key| {
-            clear &= self.is_traversable(key);
-        });
-        clear
+        crate::mapping::dda::all_keys(ua, ub, self.key_min, self.key_max, |key| {
+            self.is_traversable(key)
+        })
     }
 }
 

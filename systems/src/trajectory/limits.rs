@@ -222,50 +222,131 @@ impl Prepared {
 /// number, bit for bit, as the largest over [`segment_peaks`], when it is above `floor`;
 /// otherwise a number <= `floor`.
 ///
-/// Why not the peaks of every segment: the bisection of each grid bracket costs as much as
-/// the grid, and only the largest value decides (the ratio is monotonic in `|d|^2`). Every
-/// segment is scanned on the grid first; a bracket is then refined only if the bound on its
-/// inside could beat the ratio found so far (or `floor`), largest bound first.
+/// Why not the peaks of every segment: only the largest value decides (the ratio is monotonic
+/// in `|d|^2`), and most segments of a plan are far from binding. Each (segment, order) gets a
+/// cheap bound on its whole range first ([`segment_bound`]); they are grid-scanned largest
+/// bound first, until the bound cannot beat the ratio found so far (or `floor`). The bisection
+/// of each grid bracket costs as much as the grid, so a bracket too is refined only if the
+/// bound on its inside could beat the ratio found so far, largest bound first. A part skipped
+/// holds no value above the result, so the maximum is the same as over every part.
 pub fn worst_ratio(
     trajectory: &PiecewisePolynomial,
     max_velocity: f64,
     max_acceleration: f64,
     floor: f64,
 ) -> f64 {
-    let speed = |d2: f64| d2.sqrt() / max_velocity;
-    let acceleration = |d2: f64| (d2.sqrt() / max_acceleration).sqrt();
+    let ratio = |order: usize, d2: f64| {
+        if order == 1 {
+            d2.sqrt() / max_velocity
+        } else {
+            (d2.sqrt() / max_acceleration).sqrt()
+        }
+    };
+    let segments = trajectory.segments();
+    let mut parts: Vec<(f64, usize, usize)> = segments
+        .iter()
+        .enumerate()
+        .flat_map(|(index, segment)| {
+            [1, 2].map(|order| (ratio(order, segment_bound(segment, order)), index, order))
+        })
+        .collect();
+    parts.sort_by(|a, b| b.0.total_cmp(&a.0));
     let mut worst: f64 = 0.0;
-    let mut prepared = Vec::with_capacity(trajectory.segments().len());
+    let mut prepared = Vec::new();
     let mut pending = Vec::new();
-    for (index, segment) in trajectory.segments().iter().enumerate() {
-        let velocity = Prepared::new(segment, 1);
-        let (best, brackets) = velocity.scan::<1>();
-        worst = worst.max(speed(best));
-        pending.extend(brackets.into_iter().map(|b| (speed(b.bound), index, 1, b)));
-        let accel = Prepared::new(segment, 2);
-        let (best, brackets) = accel.scan::<2>();
-        worst = worst.max(acceleration(best));
+    for &(bound, index, order) in &parts {
+        if bound <= worst.max(floor) {
+            break;
+        }
+        let part = Prepared::new(&segments[index], order);
+        let (best, brackets) = if order == 1 {
+            part.scan::<1>()
+        } else {
+            part.scan::<2>()
+        };
+        worst = worst.max(ratio(order, best));
         pending.extend(
             brackets
                 .into_iter()
-                .map(|b| (acceleration(b.bound), index, 2, b)),
+                .map(|b| (ratio(order, b.bound), prepared.len(), order, b)),
         );
-        prepared.push([velocity, accel]);
+        prepared.push(part);
     }
     pending.sort_by(|a, b| b.0.total_cmp(&a.0));
-    for (bound, index, order, bracket) in &pending {
+    for (bound, part, order, bracket) in &pending {
         if *bound <= worst.max(floor) {
             break;
         }
-        let [velocity, accel] = &prepared[*index];
-        let ratio = if *order == 1 {
-            speed(velocity.refine::<1>(bracket))
+        let d2 = if *order == 1 {
+            prepared[*part].refine::<1>(bracket)
         } else {
-            acceleration(accel.refine::<2>(bracket))
+            prepared[*part].refine::<2>(bracket)
         };
-        worst = worst.max(ratio);
+        worst = worst.max(ratio(*order, d2));
     }
     worst
+}
+
+/// A bound on `|d|^2` over a whole segment, `d` the position's derivative of `order` (1 or 2),
+/// above every value the grid scan and the bisection of [`Prepared`] compute.
+///
+/// In the Bernstein basis of degree `m` on `tau` in [0, 1], `d(tau)` is a convex combination
+/// of its control points `b_i = sum_{j <= i} C(i, j) / C(m, j) a_j` (`a_j` its power
+/// coefficients), so `|d| <= max_i |b_i|` (the norm is convex). Each evaluation of `d` is off
+/// by at most the `rounding` of [`Prepared`] per axis (as is each computed `b_i`, far more
+/// closely), hence twice that is added to the reach.
+fn segment_bound(segment: &PolynomialSegment, order: usize) -> f64 {
+    let to_bernstein = &TO_BERNSTEIN[order - 1];
+    let scale = segment.duration.powi(-(order as i32));
+    let mut reach: f64 = 0.0;
+    let mut abs_sum = [0.0; 3];
+    for row in to_bernstein.iter().take(N - order) {
+        let mut point = [0.0; 3];
+        for (axis, p) in point.iter_mut().enumerate() {
+            let c = &segment.coefficients[axis][order..];
+            *p = row.iter().zip(c).map(|(m, c)| m * c).sum::<f64>() * scale;
+        }
+        reach = reach.max(dot(&point, &point).sqrt());
+    }
+    for (axis, sum) in abs_sum.iter_mut().enumerate() {
+        *sum = (order..N)
+            .map(|k| falling(k, order) * segment.coefficients[axis][k].abs())
+            .sum::<f64>()
+            * scale;
+    }
+    let rounding = 2e-9 * dot(&abs_sum, &abs_sum).sqrt();
+    (reach + rounding).powi(2) * (1.0 + 1e-9)
+}
+
+/// For derivative orders 1 and 2 (degree `m = N - 1 - order`), the map from the position's
+/// coefficients `c_{order..}` to the derivative's Bernstein control points (tau units):
+/// `b_i = sum_j C(i, j) / C(m, j) (j + order)! / j! c_{j + order}`.
+const TO_BERNSTEIN: [[[f64; N]; N]; 2] = [to_bernstein(1), to_bernstein(2)];
+
+const fn to_bernstein(order: usize) -> [[f64; N]; N] {
+    const fn product(from: usize, to: usize) -> f64 {
+        let (mut p, mut i) = (1.0, from);
+        while i <= to {
+            p *= i as f64;
+            i += 1;
+        }
+        p
+    }
+    const fn binomial(n: usize, k: usize) -> f64 {
+        product(n - k + 1, n) / product(1, k)
+    }
+    let degree = N - 1 - order;
+    let mut matrix = [[0.0; N]; N];
+    let mut i = 0;
+    while i <= degree {
+        let mut j = 0;
+        while j <= i {
+            matrix[i][j] = binomial(i, j) / binomial(degree, j) * product(j + 1, j + order);
+            j += 1;
+        }
+        i += 1;
+    }
+    matrix
 }
 
 /// Peak speed and peak acceleration of each segment.
@@ -347,6 +428,52 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn segment_bound_holds_every_peak_and_is_tight_on_a_straight_line() {
+        // A constant velocity (3, -4, 0) m/s over 2 s: |v| = 5 everywhere, a = 0.
+        let mut coefficients = [[0.0; N]; 4];
+        coefficients[0][1] = 6.0;
+        coefficients[1][1] = -8.0;
+        let line = PolynomialSegment {
+            duration: 2.0,
+            coefficients,
+        };
+        let bound = segment_bound(&line, 1);
+        assert!((25.0..25.0 + 1e-6).contains(&bound), "{bound}");
+        assert!(segment_bound(&line, 2) < 1e-12);
+        // Random segments: the bound is above the peak the search finds, and within the
+        // looseness expected of a control polygon (a few times the peak, not orders more).
+        let mut unit = unit_stream(0x9e37_79b9_7f4a_7c15);
+        let mut next = || unit() * 2.0 - 1.0;
+        let mut ratios = Vec::new();
+        for duration in [0.05, 0.37, 1.0, 2.9, 13.7] {
+            for _ in 0..20 {
+                let mut coefficients = [[0.0; N]; 4];
+                for output in &mut coefficients {
+                    for c in output.iter_mut() {
+                        *c = next() * 10f64.powf(2.0 * next());
+                    }
+                }
+                let segment = PolynomialSegment {
+                    duration,
+                    coefficients,
+                };
+                for order in [1, 2] {
+                    let peak = segment_peak(&segment, order);
+                    let bound = segment_bound(&segment, order);
+                    assert!(bound >= peak * peak, "{order}: {bound} < {}", peak * peak);
+                    ratios.push(bound.sqrt() / peak);
+                }
+            }
+        }
+        ratios.sort_by(f64::total_cmp);
+        assert!(
+            ratios[ratios.len() / 2] < 3.0,
+            "median looseness {}",
+            ratios[ratios.len() / 2]
+        );
     }
 
     #[test]

@@ -394,20 +394,29 @@ pub fn find_paths(
         .iter()
         .map(|&g| attach(grid, g, GOAL_SNAP_RADIUS_M))
         .collect();
-    let mut targets: Vec<usize> = ends.iter().flatten().map(|e| e.cell).collect();
-    targets.sort_unstable();
-    targets.dedup();
-    if targets.is_empty() {
+    // One bit per lattice cell, set for the goals' cells not yet settled: the test runs for
+    // every cell the search settles, and a bit lookup stays in cache where a search of the
+    // goal list is a chain of dependent loads.
+    let lattice = grid.lattice();
+    let mut pending = vec![0u64; lattice.len().div_ceil(64)];
+    let mut remaining = 0usize;
+    for end in ends.iter().flatten() {
+        let (word, bit) = (end.cell / 64, 1 << (end.cell % 64));
+        remaining += usize::from(pending[word] & bit == 0);
+        pending[word] |= bit;
+    }
+    if remaining == 0 {
         return result;
     }
-    let mut remaining = targets.len();
     let cells: Vec<Option<Vec<usize>>> = explore::<false, _>(
-        grid.lattice(),
+        lattice,
         start.cell,
         IVec3::ZERO,
         max_expansions,
         |cell| {
-            if targets.binary_search(&cell).is_ok() {
+            let (word, bit) = (cell / 64, 1 << (cell % 64));
+            if pending[word] & bit != 0 {
+                pending[word] &= !bit;
                 remaining -= 1;
             }
             remaining == 0

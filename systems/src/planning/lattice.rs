@@ -24,7 +24,7 @@ use glam::{DVec3, IVec3};
 pub const CELL_VOXELS: i32 = 2;
 /// Largest lattice (cells, border included) kept: 1 GiB of flags. Larger maps (over 2^33 voxels
 /// in the box) get no lattice, and every search on them finds nothing.
-const MAX_LATTICE_CELLS: u64 = 1 << 30;
+pub const MAX_LATTICE_CELLS: u64 = 1 << 30;
 
 /// Integer cost of an axis, face-diagonal and space-diagonal move: 1, sqrt 2 and sqrt 3 cells
 /// in thousandths (rounded, an error below 2e-4). Small integer costs let the searches use a

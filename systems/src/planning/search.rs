@@ -15,7 +15,7 @@
 //! cell index; the queue pops by cost, last in first out among equal costs, and moves are
 //! tried in a fixed order; no hash map is iterated.
 
-use super::lattice::Lattice;
+use super::lattice::{Lattice, MAX_LATTICE_CELLS, MOVE_COSTS};
 use super::traversable::TraversableGrid;
 use glam::{DVec3, IVec3};
 use std::cell::RefCell;
@@ -196,48 +196,53 @@ impl BucketQueue {
     }
 }
 
-/// A cell's state in a search: its best cost so far and the cell it came from, valid only
-/// while `mark` is the search's (see [`Nodes`]).
-#[derive(Debug, Clone, Copy)]
-struct Node {
-    cost: u64,
-    parent: u32,
-    mark: u32,
-}
-
 /// The state of every lattice cell, kept from one search to the next on each thread: a search
 /// begins by taking two new marks (reached, closed) instead of clearing lattice-sized arrays,
 /// which took longer than a short search itself (the local planner's A* expands a few
-/// hundred cells of a lattice of ~200,000). Cost, parent and mark sit together: a relaxation
-/// reads one cache line.
+/// hundred cells of a lattice of ~200,000).
+///
+/// The relaxation of a move reads the target cell's mark and cost, which share one word (the
+/// cost in the low [`COST_BITS`], the mark above): the search is bound by the latency of
+/// these reads, scattered over the lattice, so the words are kept as small as they can be
+/// (8 bytes per cell, 1.5 MB for a Pillars map) and the parents, written only when a cost
+/// improves, apart.
 struct Nodes {
-    nodes: Vec<Node>,
+    words: Vec<u64>,
+    parents: Vec<u32>,
     /// The mark of cells reached by the current search; `reached + 1` marks closed ones.
-    reached: u32,
+    reached: u64,
 }
 
-impl Nodes {
-    const UNSEEN: Node = Node {
-        cost: u64::MAX,
-        parent: NONE,
-        mark: 0,
-    };
+/// Bits of a cell's word that hold its cost. A reached cell's cost is at most that of a
+/// shortest path through every lattice cell plus one move, below `2^41`.
+const COST_BITS: u32 = 42;
+const COST_MASK: u64 = (1 << COST_BITS) - 1;
+const _: () = assert!(MAX_LATTICE_CELLS.saturating_mul(MOVE_COSTS[2]) < COST_MASK);
 
+impl Nodes {
     /// Starts a search over `len` cells: none reached.
     fn begin(&mut self, len: usize) {
-        if self.nodes.len() != len || self.reached >= u32::MAX - 2 {
-            self.nodes.clear();
-            self.nodes.resize(len, Self::UNSEEN);
+        if self.words.len() != len || self.reached + 2 >= 1 << (64 - COST_BITS) {
+            self.words.clear();
+            self.words.resize(len, 0);
+            self.parents.clear();
+            self.parents.resize(len, NONE);
             self.reached = 0;
         }
         self.reached += 2;
     }
 
+    /// The smallest word of a cell reached by this search.
+    #[inline]
+    fn reached_base(&self) -> u64 {
+        self.reached << COST_BITS
+    }
+
     #[inline]
     fn cost(&self, cell: usize) -> u64 {
-        let node = self.nodes[cell];
-        if node.mark >= self.reached {
-            node.cost
+        let word = self.words[cell];
+        if word >= self.reached_base() {
+            word & COST_MASK
         } else {
             u64::MAX
         }
@@ -245,9 +250,8 @@ impl Nodes {
 
     #[inline]
     fn parent(&self, cell: usize) -> u32 {
-        let node = self.nodes[cell];
-        if node.mark >= self.reached {
-            node.parent
+        if self.words[cell] >= self.reached_base() {
+            self.parents[cell]
         } else {
             NONE
         }
@@ -255,21 +259,20 @@ impl Nodes {
 
     #[inline]
     fn is_closed(&self, cell: usize) -> bool {
-        self.nodes[cell].mark == self.reached + 1
+        self.words[cell] >> COST_BITS == self.reached + 1
     }
 
     #[inline]
     fn close(&mut self, cell: usize) {
-        self.nodes[cell].mark = self.reached + 1;
+        let word = &mut self.words[cell];
+        *word = (*word & COST_MASK) | (self.reached + 1) << COST_BITS;
     }
 
     #[inline]
     fn reach(&mut self, cell: usize, cost: u64, parent: usize) {
-        self.nodes[cell] = Node {
-            cost,
-            parent: parent as u32,
-            mark: self.reached,
-        };
+        debug_assert!(cost <= COST_MASK);
+        self.words[cell] = self.reached_base() | cost;
+        self.parents[cell] = parent as u32;
     }
 }
 
@@ -282,7 +285,8 @@ struct Scratch {
 thread_local! {
     static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch {
         nodes: Nodes {
-            nodes: Vec::new(),
+            words: Vec::new(),
+            parents: Vec::new(),
             reached: 0,
         },
         queue: BucketQueue::new(),

@@ -84,13 +84,11 @@ fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint>
     }
     // The nearest candidate first (by distance, then index) that the point sees. The first
     // is nearly always taken, so candidates are picked by selection rather than sorted.
-    while !candidates.is_empty() {
-        let nearest = (0..candidates.len())
-            .min_by(|&a, &b| {
-                let (a, b) = (&candidates[a], &candidates[b]);
-                a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))
-            })
-            .expect("candidates left");
+    let order =
+        |a: &(f64, usize, DVec3), b: &(f64, usize, DVec3)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    while let Some(nearest) =
+        (0..candidates.len()).min_by(|&a, &b| order(&candidates[a], &candidates[b]))
+    {
         let (_, cell, centre) = candidates.swap_remove(nearest);
         if !traversable || grid.line_of_sight(point, centre) {
             return Some(Endpoint {

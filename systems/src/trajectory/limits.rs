@@ -390,6 +390,25 @@ mod tests {
         }
     }
 
+    /// A segment of `duration` whose coefficients are drawn from `next` (in [-1, 1)) with
+    /// magnitudes spread over `decades` decades either side of 1.
+    fn random_segment(
+        next: &mut impl FnMut() -> f64,
+        duration: f64,
+        decades: f64,
+    ) -> PolynomialSegment {
+        let mut coefficients = [[0.0; N]; 4];
+        for output in &mut coefficients {
+            for c in output.iter_mut() {
+                *c = next() * 10f64.powf(decades * next());
+            }
+        }
+        PolynomialSegment {
+            duration,
+            coefficients,
+        }
+    }
+
     #[test]
     fn prepared_derivatives_match_the_segment_bit_for_bit() {
         // Odd durations and coefficients of mixed sizes and signs: any change in the order of
@@ -397,16 +416,7 @@ mod tests {
         let mut unit = unit_stream(0x2545_f491_4f6c_dd1d);
         let mut next = || unit() * 2.0 - 1.0;
         for duration in [0.05, 0.37, 1.0, 2.9, 13.7] {
-            let mut coefficients = [[0.0; N]; 4];
-            for output in &mut coefficients {
-                for c in output.iter_mut() {
-                    *c = next() * 10f64.powf(3.0 * next());
-                }
-            }
-            let segment = PolynomialSegment {
-                duration,
-                coefficients,
-            };
+            let segment = random_segment(&mut next, duration, 3.0);
             let pairs = [
                 (Derivative::new(&segment, 1), Derivative::new(&segment, 2)),
                 (Derivative::new(&segment, 2), Derivative::new(&segment, 3)),
@@ -450,16 +460,7 @@ mod tests {
         let mut ratios = Vec::new();
         for duration in [0.05, 0.37, 1.0, 2.9, 13.7] {
             for _ in 0..20 {
-                let mut coefficients = [[0.0; N]; 4];
-                for output in &mut coefficients {
-                    for c in output.iter_mut() {
-                        *c = next() * 10f64.powf(2.0 * next());
-                    }
-                }
-                let segment = PolynomialSegment {
-                    duration,
-                    coefficients,
-                };
+                let segment = random_segment(&mut next, duration, 2.0);
                 for order in [1, 2] {
                     let peak = segment_peak(&segment, order);
                     let bound = segment_bound(&segment, order);

@@ -76,8 +76,13 @@ impl Derivative {
 }
 
 /// k! / (k - n)!, a small integer (exact in f64, whatever the order of the product).
-fn falling(k: usize, n: usize) -> f64 {
-    ((k + 1 - n)..=k).map(|i| i as f64).product()
+const fn falling(k: usize, n: usize) -> f64 {
+    let (mut p, mut i) = (1.0, k + 1 - n);
+    while i <= k {
+        p *= i as f64;
+        i += 1;
+    }
+    p
 }
 
 fn dot(a: &[f64; 3], b: &[f64; 3]) -> f64 {
@@ -324,16 +329,8 @@ fn segment_bound(segment: &PolynomialSegment, order: usize) -> f64 {
 const TO_BERNSTEIN: [[[f64; N]; N]; 2] = [to_bernstein(1), to_bernstein(2)];
 
 const fn to_bernstein(order: usize) -> [[f64; N]; N] {
-    const fn product(from: usize, to: usize) -> f64 {
-        let (mut p, mut i) = (1.0, from);
-        while i <= to {
-            p *= i as f64;
-            i += 1;
-        }
-        p
-    }
     const fn binomial(n: usize, k: usize) -> f64 {
-        product(n - k + 1, n) / product(1, k)
+        falling(n, k) / falling(k, k)
     }
     let degree = N - 1 - order;
     let mut matrix = [[0.0; N]; N];
@@ -341,7 +338,7 @@ const fn to_bernstein(order: usize) -> [[f64; N]; N] {
     while i <= degree {
         let mut j = 0;
         while j <= i {
-            matrix[i][j] = binomial(i, j) / binomial(degree, j) * product(j + 1, j + order);
+            matrix[i][j] = binomial(i, j) / binomial(degree, j) * falling(j + order, order);
             j += 1;
         }
         i += 1;

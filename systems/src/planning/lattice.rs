@@ -17,6 +17,10 @@
 //!
 //! The lattice is stored densely with a border of one never-traversable cell on every side, so
 //! that neighbour indices are plain offsets with no bounds checks.
+//!
+//! Each open cell also keeps the set of moves allowed from it (one bit per move), refreshed
+//! around every cell whose flag changes: a search reads one word per cell it expands instead
+//! of its 27 neighbours' flags and 26 box tests, which were a third of a Dijkstra's work.
 
 use glam::{DVec3, IVec3};
 
@@ -55,6 +59,9 @@ pub struct Lattice {
     dims: IVec3,
     /// 1 where the cell is traversable.
     cells: Vec<u8>,
+    /// Per cell, bit `k` set when move `k` of [`Self::moves`] is allowed from it (0 for a
+    /// closed cell).
+    allowed: Vec<u32>,
     /// Map cells (border excluded): `cell_min..=cell_max`.
     cell_min: IVec3,
     cell_max: IVec3,
@@ -70,15 +77,16 @@ impl Lattice {
         let cell_max = key_max >> 1i32;
         let dims = cell_max - cell_min + IVec3::splat(3);
         let count = dims.as_u64vec3().element_product();
-        let (dims, cells) = if count <= MAX_LATTICE_CELLS {
-            (dims, vec![0u8; count as usize])
+        let (dims, cells, allowed) = if count <= MAX_LATTICE_CELLS {
+            (dims, vec![0u8; count as usize], vec![0u32; count as usize])
         } else {
-            (IVec3::ZERO, Vec::new())
+            (IVec3::ZERO, Vec::new(), Vec::new())
         };
         let mut lattice = Self {
             origin: cell_min - IVec3::ONE,
             dims,
             cells,
+            allowed,
             cell_min,
             cell_max,
             moves: Vec::new(),
@@ -147,13 +155,61 @@ impl Lattice {
         self.cells[index] != 0
     }
 
-    /// Sets one map cell's flag (cells outside the map are ignored: they are never traversable,
-    /// as they hold voxels outside the map's box).
-    #[inline]
+    /// Sets one map cell's flag (see [`Self::set_cells`]).
     pub fn set(&mut self, cell: IVec3, open: bool) {
-        if let Some(i) = self.index(cell) {
-            self.cells[i] = u8::from(open);
+        self.set_cells(std::iter::once((cell, open)));
+    }
+
+    /// Sets map cells' flags (cells outside the map are ignored: they are never traversable,
+    /// as they hold voxels outside the map's box), then refreshes the allowed moves of every
+    /// cell next to one whose flag changed (once, over the box around the changes).
+    pub fn set_cells(&mut self, cells: impl IntoIterator<Item = (IVec3, bool)>) {
+        let (mut low, mut high) = (IVec3::MAX, IVec3::MIN);
+        for (cell, open) in cells {
+            if let Some(i) = self.index(cell) {
+                let flag = u8::from(open);
+                if self.cells[i] != flag {
+                    self.cells[i] = flag;
+                    low = low.min(cell);
+                    high = high.max(cell);
+                }
+            }
         }
+        if low.cmple(high).all() {
+            self.refresh_allowed(low - IVec3::ONE, high + IVec3::ONE);
+        }
+    }
+
+    /// Recomputes the allowed moves of the map cells in `low..=high` (clamped to the map).
+    fn refresh_allowed(&mut self, low: IVec3, high: IVec3) {
+        let (low, high) = (low.max(self.cell_min), high.min(self.cell_max));
+        for z in low.z..=high.z {
+            for y in low.y..=high.y {
+                let first = self.index(IVec3::new(low.x, y, z)).expect("a map cell");
+                for i in first..=first + (high.x - low.x) as usize {
+                    self.allowed[i] = if self.is_open(i) {
+                        self.moves_within(self.open_neighbours(i))
+                    } else {
+                        0
+                    };
+                }
+            }
+        }
+    }
+
+    /// The moves whose whole box is open in the neighbourhood mask `open`, as bits by index in
+    /// [`Self::moves`].
+    fn moves_within(&self, open: u32) -> u32 {
+        self.moves.iter().enumerate().fold(0, |allowed, (k, mv)| {
+            allowed | u32::from(open & mv.box_mask == mv.box_mask) << k
+        })
+    }
+
+    /// The moves allowed from the cell at `index` (bit `k`: move `k` of [`Self::moves`]); none
+    /// from a closed cell.
+    #[inline]
+    pub fn allowed_moves(&self, index: usize) -> u32 {
+        self.allowed[index]
     }
 
     /// The 26 moves, in a fixed order (z, then y, then x offset ascending).
@@ -304,5 +360,47 @@ mod tests {
             let allowed = mask & mv.box_mask == mv.box_mask;
             assert_eq!(allowed, mv.delta.x != 1, "{}", mv.delta);
         }
+    }
+
+    /// The allowed moves kept per cell stay those of a fresh box test of every move, whatever
+    /// the order and batching of the flag changes (a stale mask would let a search cut
+    /// through a cell closed since).
+    #[test]
+    fn allowed_moves_follow_every_change() {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(7);
+        let (key_min, key_max) = (IVec3::new(-4, 0, 2), IVec3::new(9, 11, 7));
+        let mut lattice = Lattice::new(key_min, key_max);
+        let (low, high) = (key_min >> 1i32, key_max >> 1i32);
+        for round in 0..200 {
+            let batch: Vec<(IVec3, bool)> = (0..rng.random_range(1..12))
+                .map(|_| {
+                    let cell = IVec3::new(
+                        rng.random_range(low.x - 1..=high.x + 1),
+                        rng.random_range(low.y - 1..=high.y + 1),
+                        rng.random_range(low.z - 1..=high.z + 1),
+                    );
+                    (cell, rng.random_bool(0.7))
+                })
+                .collect();
+            lattice.set_cells(batch);
+            for i in 0..lattice.len() {
+                let expected = if lattice.is_open(i) {
+                    lattice.moves().iter().enumerate().fold(0, |m, (k, mv)| {
+                        let open = lattice.open_neighbours(i);
+                        m | u32::from(open & mv.box_mask == mv.box_mask) << k
+                    })
+                } else {
+                    0
+                };
+                assert_eq!(
+                    lattice.allowed_moves(i),
+                    expected,
+                    "round {round}, cell {i}"
+                );
+            }
+        }
+        // Some cells ended up with moves allowed, so the check above compared real masks.
+        assert!((0..lattice.len()).any(|i| lattice.allowed_moves(i).count_ones() > 3));
     }
 }

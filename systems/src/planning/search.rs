@@ -238,8 +238,13 @@ impl Nodes {
 
     #[inline]
     fn cost(&self, cell: usize) -> u64 {
-        let word = self.words[cell];
-        if word >= self.reached_base() {
+        Self::cost_of(self.words[cell], self.reached_base())
+    }
+
+    /// The cost a cell's `word` holds, given the search's [`Self::reached_base`].
+    #[inline]
+    fn cost_of(word: u64, base: u64) -> u64 {
+        if word >= base {
             word & COST_MASK
         } else {
             u64::MAX
@@ -268,8 +273,14 @@ impl Nodes {
 
     #[inline]
     fn reach(&mut self, cell: usize, cost: u64, parent: usize) {
+        self.reach_with(cell, cost, parent, self.reached_base());
+    }
+
+    /// [`Self::reach`] given the search's [`Self::reached_base`].
+    #[inline]
+    fn reach_with(&mut self, cell: usize, cost: u64, parent: usize, base: u64) {
         debug_assert!(cost <= COST_MASK);
-        self.words[cell] = self.reached_base() | cost;
+        self.words[cell] = base | cost;
         self.parents[cell] = parent as u32;
     }
 }
@@ -313,6 +324,7 @@ fn explore<const ASTAR: bool, R>(
     SCRATCH.with_borrow_mut(|Scratch { nodes, queue }| {
         nodes.begin(lattice.len());
         nodes.reach(start, 0, NONE as usize);
+        let moves = lattice.moves();
         let start_cell = lattice.cell(start);
         queue.reset(heuristic(start_cell));
         queue.push(queue.current, start);
@@ -335,16 +347,18 @@ fn explore<const ASTAR: bool, R>(
             } else {
                 IVec3::ZERO
             };
-            let open = lattice.open_neighbours(index);
-            for mv in lattice.moves() {
-                if open & mv.box_mask != mv.box_mask {
-                    continue;
-                }
+            // The allowed moves in their fixed order (lowest bit first). The mark base is read
+            // once: the compiler cannot tell that the writes to the cells leave it unchanged.
+            let base = nodes.reached_base();
+            let mut allowed = lattice.allowed_moves(index);
+            while allowed != 0 {
+                let mv = &moves[allowed.trailing_zeros() as usize];
+                allowed &= allowed - 1;
                 let next = index.wrapping_add_signed(mv.offset);
                 let g_next = g + mv.cost;
                 // A closed cell already has a cost <= g (consistent heuristic): no closed check.
-                if g_next < nodes.cost(next) {
-                    nodes.reach(next, g_next, index);
+                if g_next < Nodes::cost_of(nodes.words[next], base) {
+                    nodes.reach_with(next, g_next, index, base);
                     queue.push(g_next + heuristic(cell + mv.delta), next);
                 }
             }

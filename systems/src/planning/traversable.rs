@@ -486,20 +486,19 @@ impl TraversableGrid {
     fn update_lattice(&mut self, first: IVec3, rows: Option<&ChunkRows>) {
         let first_cell = Lattice::cell_of_key(first);
         let cells = EDGE / 2;
-        for cz in 0..cells {
-            for cy in 0..cells {
+        let flags = (0..cells).flat_map(|cz| {
+            (0..cells).flat_map(move |cy| {
                 let m = rows.map_or(0, |rows| {
                     let at = |y: i32, z: i32| rows[(y + EDGE * z) as usize];
                     let (y, z) = (2 * cy, 2 * cz);
                     let r = at(y, z) & at(y + 1, z) & at(y, z + 1) & at(y + 1, z + 1);
                     r & (r >> 1)
                 });
-                for cx in 0..cells {
-                    let open = m >> (2 * cx) & 1 == 1;
-                    self.lattice.set(first_cell + IVec3::new(cx, cy, cz), open);
-                }
-            }
-        }
+                (0..cells)
+                    .map(move |cx| (first_cell + IVec3::new(cx, cy, cz), m >> (2 * cx) & 1 == 1))
+            })
+        });
+        self.lattice.set_cells(flags);
     }
 
     /// Whether every voxel from `a` to `b` (world points) on the straight segment is

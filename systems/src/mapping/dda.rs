@@ -233,30 +233,29 @@ impl VoxelWalk {
         }
     }
 
-    /// Moves to the next voxel; returns which axis it moved along (exactly one is `true`).
-    /// Only meaningful while [`Self::steps_left`] > 0.
+    /// Moves to the next voxel. Only meaningful while [`Self::steps_left`] > 0.
     ///
     /// The axis is the one with the earliest boundary; ties go to x, then y, then z (the map
-    /// update's inner loop decides the same way).
+    /// update's inner loop decides the same way). Only that axis' state changes: an axis with
+    /// no step left already has the boundary time [`T_RETIRED`] (set when its count ran out).
     #[inline(always)]
-    pub fn advance(&mut self) -> [bool; 3] {
+    pub fn advance(&mut self) {
         let t = self.t_max;
-        let x = (t[0] <= t[1]) & (t[0] <= t[2]);
-        let y = !x & (t[1] <= t[2]);
-        let moved = [x, y, !x & !y];
-        for axis in 0..3 {
-            let m = moved[axis];
-            let remaining = self.remaining[axis].saturating_sub(u32::from(m));
-            self.remaining[axis] = remaining;
-            let next = if m {
-                t[axis].saturating_add(self.t_delta[axis])
-            } else {
-                t[axis]
-            };
-            self.t_max[axis] = if remaining == 0 { T_RETIRED } else { next };
-            self.key[axis] += if m { self.step[axis] } else { 0 };
-        }
-        moved
+        let axis = if (t[0] <= t[1]) & (t[0] <= t[2]) {
+            0
+        } else if t[1] <= t[2] {
+            1
+        } else {
+            2
+        };
+        let remaining = self.remaining[axis].saturating_sub(1);
+        self.remaining[axis] = remaining;
+        self.t_max[axis] = if remaining == 0 {
+            T_RETIRED
+        } else {
+            t[axis].saturating_add(self.t_delta[axis])
+        };
+        self.key[axis] += self.step[axis];
     }
 }
 

@@ -254,14 +254,14 @@ impl TraversableGrid {
         if key.cmplt(self.key_min).any() || key.cmpgt(self.key_max).any() {
             return false;
         }
-        let flat = self.chunk_grid.flat_unchecked(ChunkCoord::of_key(key));
-        match &self.chunks[flat] {
-            Some(rows) => {
-                let l = key & (EDGE - 1);
-                rows[(l.y + EDGE * l.z) as usize] >> l.x & 1 == 1
-            }
-            None => false,
-        }
+        self.rows_of(ChunkCoord::of_key(key))
+            .is_some_and(|rows| row_bit(rows, key))
+    }
+
+    /// The traversable rows of the chunk at `coord` (inside the map), if any voxel of it is.
+    #[inline]
+    fn rows_of(&self, coord: ChunkCoord) -> Option<&ChunkRows> {
+        self.chunks[self.chunk_grid.flat_unchecked(coord)].as_deref()
     }
 
     /// Whether the voxel holding `p` is traversable (false for non-finite points).
@@ -512,10 +512,25 @@ impl TraversableGrid {
             return false;
         }
         let (ua, ub) = (a / self.resolution, b / self.resolution);
+        // The walk stays in the map's keys and in one chunk for up to 16 steps: the chunk's
+        // rows are looked up when it changes, not at every voxel.
+        let mut chunk = (ChunkCoord::of_key(self.key_of(a)), None);
+        chunk.1 = self.rows_of(chunk.0);
         crate::mapping::dda::all_keys(ua, ub, self.key_min, self.key_max, |key| {
-            self.is_traversable(key)
+            let coord = ChunkCoord::of_key(key);
+            if coord != chunk.0 {
+                chunk = (coord, self.rows_of(coord));
+            }
+            chunk.1.is_some_and(|rows| row_bit(rows, key))
         })
     }
+}
+
+/// Bit of voxel `key` in its chunk's rows.
+#[inline]
+fn row_bit(rows: &ChunkRows, key: IVec3) -> bool {
+    let l = key & (EDGE - 1);
+    rows[(l.y + EDGE * l.z) as usize] >> l.x & 1 == 1
 }
 
 /// The inflation ball as x-runs: the whole-voxel reach and every (dy, dz) row with its

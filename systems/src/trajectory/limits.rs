@@ -257,8 +257,8 @@ pub fn worst_ratio(
         .collect();
     parts.sort_by(|a, b| b.0.total_cmp(&a.0));
     let mut worst: f64 = 0.0;
-    let mut prepared = Vec::new();
-    let mut pending = Vec::new();
+    let mut prepared = Vec::with_capacity(parts.len());
+    let mut pending = Vec::with_capacity(parts.len());
     for &(bound, index, order) in &parts {
         if bound <= worst.max(floor) {
             break;

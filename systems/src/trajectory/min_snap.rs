@@ -104,8 +104,8 @@ pub fn solve_outputs(
     let mut factor: Option<FreeBlock> = None;
     let mut solved = Vec::with_capacity(outputs.len());
     for constraints in outputs {
-        let mut free = Vec::new();
-        let mut fixed = Vec::new();
+        let mut free = Vec::with_capacity(ORDERS * joints);
+        let mut fixed = Vec::with_capacity(ORDERS * joints);
         let mut values = vec![0.0; ORDERS * joints];
         for (joint, orders) in constraints.values.iter().enumerate() {
             for (order, value) in orders.iter().enumerate() {
@@ -130,12 +130,19 @@ pub fn solve_outputs(
             }
             let block = factor.as_ref().expect("factorised above");
             // R_PP x = -R_PF d_F, with R_PP scaled to unit diagonal: D R_PP D y = -D R_PF d_F.
-            let mut y: Vec<f64> = (0..block.free.len())
-                .map(|a| {
-                    -block.scale[a]
-                        * fixed
+            // Only the fixed variables within the band of a free one meet it in `R` (`fixed`
+            // is ascending); the others' terms are zeros.
+            let mut y: Vec<f64> = block
+                .free
+                .iter()
+                .zip(&block.scale)
+                .map(|(&q, &scale)| {
+                    let first = fixed.partition_point(|&f| f + BAND < q);
+                    -scale
+                        * fixed[first..]
                             .iter()
-                            .map(|&f| form.get(block.free[a], f) * values[f])
+                            .take_while(|&&f| f <= q + BAND)
+                            .map(|&f| form.get(q, f) * values[f])
                             .sum::<f64>()
                 })
                 .collect();

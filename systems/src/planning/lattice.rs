@@ -155,23 +155,41 @@ impl Lattice {
         self.cells[index] != 0
     }
 
-    /// Sets one map cell's flag (see [`Self::set_cells`]).
+    /// Sets one map cell's flag (cells outside the map are ignored: they are never traversable,
+    /// as they hold voxels outside the map's box), and refreshes the allowed moves around it
+    /// if it changed.
     pub fn set(&mut self, cell: IVec3, open: bool) {
-        self.set_cells(std::iter::once((cell, open)));
+        if let Some(i) = self.index(cell) {
+            let flag = u8::from(open);
+            if self.cells[i] != flag {
+                self.cells[i] = flag;
+                self.refresh_allowed(cell - IVec3::ONE, cell + IVec3::ONE);
+            }
+        }
     }
 
-    /// Sets map cells' flags (cells outside the map are ignored: they are never traversable,
-    /// as they hold voxels outside the map's box), then refreshes the allowed moves of every
-    /// cell next to one whose flag changed (once, over the box around the changes).
-    pub fn set_cells(&mut self, cells: impl IntoIterator<Item = (IVec3, bool)>) {
+    /// Sets the flags of the cube of `edge` cells per side from `first`, row by row (bit `x`
+    /// of `row(y, z)` opens cell `first + (x, y, z)`; cells outside the map are ignored), then
+    /// refreshes the allowed moves once, over the box around the cells that changed.
+    pub fn set_rows(&mut self, first: IVec3, edge: i32, row: impl Fn(i32, i32) -> u32) {
         let (mut low, mut high) = (IVec3::MAX, IVec3::MIN);
-        for (cell, open) in cells {
-            if let Some(i) = self.index(cell) {
-                let flag = u8::from(open);
-                if self.cells[i] != flag {
-                    self.cells[i] = flag;
-                    low = low.min(cell);
-                    high = high.max(cell);
+        let x_first = first.x.max(self.cell_min.x);
+        let x_last = (first.x + edge - 1).min(self.cell_max.x);
+        for z in 0..edge {
+            for y in 0..edge {
+                let row_first = IVec3::new(x_first, first.y + y, first.z + z);
+                let Some(start) = self.index(row_first).filter(|_| x_first <= x_last) else {
+                    continue;
+                };
+                let bits = row(y, z) >> (x_first - first.x);
+                for (i, x) in (start..).zip(x_first..=x_last) {
+                    let flag = (bits >> (x - x_first) & 1) as u8;
+                    if self.cells[i] != flag {
+                        self.cells[i] = flag;
+                        let cell = IVec3::new(x, row_first.y, row_first.z);
+                        low = low.min(cell);
+                        high = high.max(cell);
+                    }
                 }
             }
         }
@@ -383,7 +401,21 @@ mod tests {
                     (cell, rng.random_bool(0.7))
                 })
                 .collect();
-            lattice.set_cells(batch);
+            if round % 2 == 0 {
+                batch
+                    .into_iter()
+                    .for_each(|(cell, open)| lattice.set(cell, open));
+            } else {
+                // A cube of cells from the first one's, open where its batch draws fell.
+                let first = batch[0].0;
+                let opened: Vec<IVec3> = batch.iter().filter(|b| b.1).map(|b| b.0).collect();
+                lattice.set_rows(first, 3, |y, z| {
+                    (0..3).fold(0, |bits, x| {
+                        let cell = first + IVec3::new(x, y, z);
+                        bits | u32::from(opened.contains(&cell) || (x + y + z) % 2 == 0) << x
+                    })
+                });
+            }
             for i in 0..lattice.len() {
                 let expected = if lattice.is_open(i) {
                     lattice.moves().iter().enumerate().fold(0, |m, (k, mv)| {

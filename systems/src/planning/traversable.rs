@@ -485,20 +485,20 @@ impl TraversableGrid {
     /// Writes the chunk's cells into the lattice (a cell is open when all 8 voxels are).
     fn update_lattice(&mut self, first: IVec3, rows: Option<&ChunkRows>) {
         let first_cell = Lattice::cell_of_key(first);
-        let cells = EDGE / 2;
-        let flags = (0..cells).flat_map(|cz| {
-            (0..cells).flat_map(move |cy| {
-                let m = rows.map_or(0, |rows| {
-                    let at = |y: i32, z: i32| rows[(y + EDGE * z) as usize];
-                    let (y, z) = (2 * cy, 2 * cz);
-                    let r = at(y, z) & at(y + 1, z) & at(y, z + 1) & at(y + 1, z + 1);
-                    r & (r >> 1)
-                });
-                (0..cells)
-                    .map(move |cx| (first_cell + IVec3::new(cx, cy, cz), m >> (2 * cx) & 1 == 1))
+        // Bit 2x of a voxel row pair's AND with itself shifted: voxels 2x and 2x + 1 free.
+        let cell_bits = |pair: u16| {
+            (0..EDGE / 2).fold(0u32, |bits, cx| {
+                bits | u32::from(pair >> (2 * cx) & 1) << cx
+            })
+        };
+        self.lattice.set_rows(first_cell, EDGE / 2, |cy, cz| {
+            rows.map_or(0, |rows| {
+                let at = |y: i32, z: i32| rows[(y + EDGE * z) as usize];
+                let (y, z) = (2 * cy, 2 * cz);
+                let r = at(y, z) & at(y + 1, z) & at(y, z + 1) & at(y + 1, z + 1);
+                cell_bits(r & (r >> 1))
             })
         });
-        self.lattice.set_cells(flags);
     }
 
     /// Whether every voxel from `a` to `b` (world points) on the straight segment is

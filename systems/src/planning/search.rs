@@ -56,7 +56,7 @@ fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint>
     // rounding) hold no candidate and are skipped whole.
     let beyond = radius * radius * (1.0 + 1e-9);
     let offset = |d: IVec3| lattice.centre(home + d, resolution) - point;
-    let mut candidates = Vec::with_capacity((2 * n as usize + 1).pow(3));
+    let mut candidates = Vec::new();
     for dz in -n..=n {
         let z2 = offset(IVec3::Z * dz).z.powi(2);
         if z2 > beyond {

@@ -418,10 +418,7 @@ mod tests {
             }
             for i in 0..lattice.len() {
                 let expected = if lattice.is_open(i) {
-                    lattice.moves().iter().enumerate().fold(0, |m, (k, mv)| {
-                        let open = lattice.open_neighbours(i);
-                        m | u32::from(open & mv.box_mask == mv.box_mask) << k
-                    })
+                    lattice.moves_within(lattice.open_neighbours(i))
                 } else {
                     0
                 };

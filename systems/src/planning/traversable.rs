@@ -514,8 +514,8 @@ impl TraversableGrid {
         let (ua, ub) = (a / self.resolution, b / self.resolution);
         // The walk stays in the map's keys and in one chunk for up to 16 steps: the chunk's
         // rows are looked up when it changes, not at every voxel.
-        let mut chunk = (ChunkCoord::of_key(self.key_of(a)), None);
-        chunk.1 = self.rows_of(chunk.0);
+        let first = ChunkCoord::of_key(self.key_of(a));
+        let mut chunk = (first, self.rows_of(first));
         crate::mapping::dda::all_keys(ua, ub, self.key_min, self.key_max, |key| {
             let coord = ChunkCoord::of_key(key);
             if coord != chunk.0 {

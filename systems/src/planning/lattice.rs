@@ -159,13 +159,7 @@ impl Lattice {
     /// as they hold voxels outside the map's box), and refreshes the allowed moves around it
     /// if it changed.
     pub fn set(&mut self, cell: IVec3, open: bool) {
-        if let Some(i) = self.index(cell) {
-            let flag = u8::from(open);
-            if self.cells[i] != flag {
-                self.cells[i] = flag;
-                self.refresh_allowed(cell - IVec3::ONE, cell + IVec3::ONE);
-            }
-        }
+        self.set_rows(cell, 1, |_, _| u32::from(open));
     }
 
     /// Sets the flags of the cube of `edge` cells per side from `first`, row by row (bit `x`

@@ -304,7 +304,6 @@ fn segment_bound(segment: &PolynomialSegment, order: usize) -> f64 {
     let to_bernstein = &TO_BERNSTEIN[order - 1];
     let scale = segment.duration.powi(-(order as i32));
     let mut reach: f64 = 0.0;
-    let mut abs_sum = [0.0; 3];
     for row in to_bernstein.iter().take(N - order) {
         let mut point = [0.0; 3];
         for (axis, p) in point.iter_mut().enumerate() {
@@ -313,12 +312,12 @@ fn segment_bound(segment: &PolynomialSegment, order: usize) -> f64 {
         }
         reach = reach.max(dot(&point, &point).sqrt());
     }
-    for (axis, sum) in abs_sum.iter_mut().enumerate() {
-        *sum = (order..N)
+    let abs_sum: [f64; 3] = std::array::from_fn(|axis| {
+        (order..N)
             .map(|k| falling(k, order) * segment.coefficients[axis][k].abs())
             .sum::<f64>()
-            * scale;
-    }
+            * scale
+    });
     let rounding = 2e-9 * dot(&abs_sum, &abs_sum).sqrt();
     (reach + rounding).powi(2) * (1.0 + 1e-9)
 }

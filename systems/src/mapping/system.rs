@@ -207,10 +207,12 @@ impl<'w> EcsChunks<'_, 'w> {
             index.set_flat(new.flat, entity);
         }
     }
-}
 
-impl ChunkAccess for EcsChunks<'_, '_> {
-    fn chunk_mut(&mut self, flat: usize, coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums) {
+    /// A chunk created during this run, made now if it is not yet (the map update's walks
+    /// ask for a chunk at every chunk they enter: the lent ones are the hot path).
+    #[cold]
+    #[inline(never)]
+    fn created_mut(&mut self, flat: usize, coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums) {
         let mut slot = self.slot_of[flat];
         if slot == NO_SLOT {
             slot = CREATED | self.created.len() as u32;
@@ -222,16 +224,24 @@ impl ChunkAccess for EcsChunks<'_, '_> {
                 stats: StatSums::default(),
             });
         }
+        let new = &mut self.created[(slot & !CREATED) as usize];
+        (&mut new.chunk, &mut new.stats)
+    }
+}
+
+impl ChunkAccess for EcsChunks<'_, '_> {
+    #[inline]
+    fn chunk_mut(&mut self, flat: usize, coord: ChunkCoord) -> (&mut VoxelChunk, &mut StatSums) {
+        let slot = self.slot_of[flat];
+        // `NO_SLOT` has the `CREATED` bit too: a chunk not lent is made or found apart.
         if slot & CREATED != 0 {
-            let new = &mut self.created[(slot & !CREATED) as usize];
-            (&mut new.chunk, &mut new.stats)
-        } else {
-            let lent = &mut self.existing[slot as usize];
-            (
-                lent.chunk.bypass_change_detection(),
-                &mut lent.stats.bypass_change_detection().0,
-            )
+            return self.created_mut(flat, coord);
         }
+        let lent = &mut self.existing[slot as usize];
+        (
+            lent.chunk.bypass_change_detection(),
+            &mut lent.stats.bypass_change_detection().0,
+        )
     }
 
     fn mark_written(&mut self, flat: usize) {

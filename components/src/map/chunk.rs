@@ -241,6 +241,18 @@ impl VoxelChunk {
         &self.saturation
     }
 
+    /// Bit x of the voxel (x, y, z) for which `pred` holds, in the x-row `row = y + 16 z`
+    /// (local indices `16 row ..= 16 row + 15`): one row as a machine word, for the consumers
+    /// that work on 16 voxels at a time (frontiers, traversability).
+    #[inline]
+    pub fn row_bits(&self, row: usize, pred: impl Fn(Voxel) -> bool) -> u16 {
+        let start = (row * CHUNK_EDGE as usize) % CHUNK_VOXELS;
+        self.voxels[start..start + CHUNK_EDGE as usize]
+            .iter()
+            .enumerate()
+            .fold(0u16, |bits, (x, &v)| bits | (u16::from(pred(v)) << x))
+    }
+
     /// Stored log-odds (milli units) at local index `index`.
     #[inline]
     pub fn log_odds_milli(&self, index: usize) -> i16 {

@@ -49,11 +49,7 @@ pub const NEIGHBOURS: [IVec3; 6] = [
 /// Bits `x` of the voxels of row (y, z) of `chunk` for which `pred` holds.
 #[inline]
 fn row_bits(chunk: &VoxelChunk, y: usize, z: usize, pred: impl Fn(Voxel) -> bool) -> u16 {
-    let start = (y + EDGE * z) * EDGE;
-    let row = &chunk.voxels()[start..start + EDGE];
-    row.iter()
-        .enumerate()
-        .fold(0u16, |bits, (x, &v)| bits | (u16::from(pred(v)) << x))
+    chunk.row_bits(y + EDGE * z, pred)
 }
 
 fn is_unknown(v: Voxel) -> bool {

@@ -399,6 +399,33 @@ fn the_ecs_system_marks_changed_chunks_dirty() {
     schedule.run(&mut world);
 }
 
+/// The assumption holds over what the map says: a voxel observed occupied inside the assumed
+/// ball blocks nothing, one just outside it blocks its inflation as usual.
+#[test]
+fn an_assumed_free_voxel_counts_as_free_even_if_observed_occupied() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::splat(3.2));
+    let centre = IVec3::splat(16);
+    // Free everywhere, an occupied voxel inside the ball (1 from the centre) and one outside
+    // it (7 from the centre, in the chunk before the centre's along -x: the halo's rows are
+    // gathered from both chunks).
+    map.fill_all(-2000);
+    map.set(centre + IVec3::new(1, 0, 0), 3000);
+    map.set(centre - IVec3::new(7, 0, 0), 3000);
+    let mut grid = TraversableGrid::new(&map.config, 0.2);
+    grid.assume_free_ball((centre.as_dvec3() + 0.5) * 0.1, 0.5);
+    map.update(&mut grid);
+    // 2-voxel inflation: the centre and its +x neighbour are clear (the occupied voxel inside
+    // the ball is assumed free), -5 is blocked by the one at -7, -4 is not.
+    for (offset, expected) in [
+        (IVec3::ZERO, true),
+        (IVec3::new(1, 0, 0), true),
+        (IVec3::new(-4, 0, 0), true),
+        (IVec3::new(-5, 0, 0), false),
+    ] {
+        assert_eq!(grid.is_traversable(centre + offset), expected, "{offset}");
+    }
+}
+
 #[test]
 fn a_ball_assumed_free_is_traversable_where_it_holds_the_whole_inflation() {
     // Nothing observed; a ball of 5 voxels assumed free around the centre of voxel 16, with a

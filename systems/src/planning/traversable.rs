@@ -312,7 +312,6 @@ impl TraversableGrid {
 
     /// Known-free voxels of the chunk inside the map box, as rows.
     fn free_rows(&self, chunk: &uavex_components::map::VoxelChunk, first: IVec3) -> ChunkRows {
-        let voxels = chunk.voxels();
         let mut rows = [0u16; ROWS];
         // Bits of x keys inside the box.
         let mut x_mask = 0u16;
@@ -331,13 +330,8 @@ impl TraversableGrid {
                     continue;
                 }
                 let row = (ly + EDGE * lz) as usize;
-                let base = row * EDGE as usize;
-                let mut bits = 0u16;
-                for lx in 0..EDGE as usize {
-                    // Free: known (not i16::MIN) with l < 0.
-                    let l = voxels[base + lx].log_odds;
-                    bits |= u16::from(l < 0 && l != i16::MIN) << lx;
-                }
+                // Free: known (not i16::MIN) with l < 0.
+                let bits = chunk.row_bits(row, |v| v.log_odds < 0 && v.log_odds != i16::MIN);
                 rows[row] = bits & x_mask;
             }
         }
@@ -450,31 +444,36 @@ impl TraversableGrid {
                     if lo.cmpgt(hi).any() {
                         continue;
                     }
+                    // The chunk's x range inside the halo and the box, as bits of its rows,
+                    // and where its bit 0 lands in a halo row (left of it for a chunk that
+                    // starts before the halo).
+                    let (lx_lo, lx_hi) = ((lo.x - c_first.x) as u32, (hi.x - c_first.x) as u32);
+                    let in_range = ((1u32 << (lx_hi + 1)) - (1u32 << lx_lo)) as u16;
+                    let shift = c_first.x - halo_min.x;
+                    let to_halo = |bits: u16| {
+                        let bits = u64::from(bits & in_range);
+                        if shift >= 0 {
+                            bits << shift
+                        } else {
+                            bits >> -shift
+                        }
+                    };
                     for z in lo.z..=hi.z {
                         for y in lo.y..=hi.y {
                             let local_row = ((y - c_first.y) + EDGE * (z - c_first.z)) as usize;
                             let i = (y - halo_min.y) as usize + gw * (z - halo_min.z) as usize;
                             let assumed_row = assumed.map_or(0, |a| a[local_row]);
-                            let (mut known, mut occupied) = (0u64, 0u64);
-                            for x in lo.x..=hi.x {
-                                let lx = x - c_first.x;
-                                let bit = 1u64 << (x - halo_min.x);
-                                if assumed_row >> lx & 1 == 1 {
-                                    known |= bit;
-                                    continue;
-                                }
-                                let Some(chunk) = chunk else { continue };
-                                let l = chunk.voxels()[local_row * EDGE as usize + lx as usize]
-                                    .log_odds;
-                                if l != i16::MIN {
-                                    known |= bit;
-                                    if l >= 0 {
-                                        occupied |= bit;
-                                    }
-                                }
-                            }
-                            self.gathered_unknown[i] &= !known;
-                            self.gathered_occupied[i] |= occupied;
+                            // Occupied: l >= 0 (the unknown marker `i16::MIN` is negative).
+                            let (known, occupied) = chunk.map_or((0, 0), |chunk| {
+                                (
+                                    chunk.row_bits(local_row, |v| v.log_odds != i16::MIN),
+                                    chunk.row_bits(local_row, |v| v.log_odds >= 0),
+                                )
+                            });
+                            // An assumed-free voxel is known and not occupied, whatever the map
+                            // holds.
+                            self.gathered_unknown[i] &= !to_halo(known | assumed_row);
+                            self.gathered_occupied[i] |= to_halo(occupied & !assumed_row);
                         }
                     }
                 }

@@ -293,6 +293,22 @@ mod tests {
     use super::*;
     use crate::map::BRICK_VOXELS;
 
+    /// Row bits hold bit x for voxel x of the row: every 16-bit pattern of a predicate, each
+    /// written into row `pattern % 256`.
+    #[test]
+    fn row_bits_hold_bit_x_for_voxel_x_of_the_row() {
+        let mut chunk = VoxelChunk::new();
+        for pattern in 0..=u16::MAX {
+            let row = usize::from(pattern) % 256;
+            for x in 0..16 {
+                let index = row * 16 + x;
+                chunk.voxels_mut()[index].log_odds = if pattern >> x & 1 == 1 { 100 } else { -100 };
+            }
+            let bits = chunk.row_bits(row, |v| v.log_odds > 0);
+            assert_eq!(bits, pattern, "row {row}");
+        }
+    }
+
     #[test]
     fn negative_keys_address_the_chunk_below() {
         // key -1 lies in chunk -1 at local 15; key -16 in chunk -1 at local 0; -17 in chunk -2.

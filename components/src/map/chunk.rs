@@ -137,6 +137,24 @@ impl Voxel {
     pub fn state(self) -> VoxelState {
         VoxelState::of_milli(self.log_odds)
     }
+
+    /// Never observed (`state() == Unknown`, as one compare).
+    #[inline]
+    pub fn is_unknown(self) -> bool {
+        self.log_odds == UNKNOWN_LOG_ODDS
+    }
+
+    /// Known with l < 0 (`state() == Free`).
+    #[inline]
+    pub fn is_free(self) -> bool {
+        self.log_odds < 0 && !self.is_unknown()
+    }
+
+    /// Known with l >= 0 (`state() == Occupied`; the unknown marker is negative).
+    #[inline]
+    pub fn is_occupied(self) -> bool {
+        self.log_odds >= 0
+    }
 }
 
 /// The voxels of one chunk, indexed by [`local_index`], plus the stamp epoch and, per brick,
@@ -292,6 +310,18 @@ impl VoxelChunk {
 mod tests {
     use super::*;
     use crate::map::BRICK_VOXELS;
+
+    /// The one-compare state predicates agree with `state()` on every log-odds value.
+    #[test]
+    fn state_predicates_agree_with_the_state() {
+        for log_odds in i16::MIN..=i16::MAX {
+            let v = Voxel { log_odds, stamp: 0 };
+            let state = v.state();
+            assert_eq!(v.is_unknown(), state == VoxelState::Unknown, "{log_odds}");
+            assert_eq!(v.is_free(), state == VoxelState::Free, "{log_odds}");
+            assert_eq!(v.is_occupied(), state == VoxelState::Occupied, "{log_odds}");
+        }
+    }
 
     /// Row bits hold bit x for voxel x of the row: every 16-bit pattern of a predicate, each
     /// written into row `pattern % 256`.

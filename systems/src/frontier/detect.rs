@@ -15,9 +15,7 @@
 use super::super::mapping::OccupancyMap;
 use glam::IVec3;
 use uavex_components::frontier::{FrontierSet, VoxelMask};
-use uavex_components::map::{
-    CHUNK_EDGE, ChunkCoord, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk, VoxelState,
-};
+use uavex_components::map::{CHUNK_EDGE, ChunkCoord, Voxel, VoxelChunk, VoxelState};
 
 /// Padded edge: the chunk's 16 voxels plus one neighbour layer on each side.
 const PADDED: usize = CHUNK_EDGE as usize + 2;
@@ -52,22 +50,14 @@ fn row_bits(chunk: &VoxelChunk, y: usize, z: usize, pred: impl Fn(Voxel) -> bool
     chunk.row_bits(y + EDGE * z, pred)
 }
 
-fn is_unknown(v: Voxel) -> bool {
-    v.log_odds == UNKNOWN_LOG_ODDS
-}
-
-fn is_free(v: Voxel) -> bool {
-    v.log_odds < 0 && v.log_odds != UNKNOWN_LOG_ODDS
-}
-
 /// Unknown bits of row (y, z) of a neighbour chunk; a chunk never created is all unknown.
 fn unknown_row(chunk: Option<&VoxelChunk>, y: usize, z: usize) -> u16 {
-    chunk.map_or(u16::MAX, |c| row_bits(c, y, z, is_unknown))
+    chunk.map_or(u16::MAX, |c| row_bits(c, y, z, Voxel::is_unknown))
 }
 
 /// Whether voxel (x, y, z) of a neighbour chunk is unknown.
 fn unknown_voxel(chunk: Option<&VoxelChunk>, x: usize, y: usize, z: usize) -> bool {
-    chunk.is_none_or(|c| is_unknown(c.voxels()[x + EDGE * (y + EDGE * z)]))
+    chunk.is_none_or(|c| c.voxels()[x + EDGE * (y + EDGE * z)].is_unknown())
 }
 
 /// The frontier voxels of the chunk at `coord` (see the module documentation).
@@ -80,7 +70,7 @@ pub fn chunk_frontier(map: &impl OccupancyMap, coord: ChunkCoord) -> VoxelMask {
     let mut free = [0u16; EDGE * EDGE];
     for z in 0..EDGE {
         for y in 0..EDGE {
-            free[y + EDGE * z] = row_bits(chunk, y, z, is_free);
+            free[y + EDGE * z] = row_bits(chunk, y, z, Voxel::is_free);
         }
     }
     if free.iter().all(|&r| r == 0) {
@@ -94,7 +84,7 @@ pub fn chunk_frontier(map: &impl OccupancyMap, coord: ChunkCoord) -> VoxelMask {
     let (nx, px) = (neighbour(IVec3::NEG_X), neighbour(IVec3::X));
     for z in 0..EDGE {
         for y in 0..EDGE {
-            let inner = u32::from(row_bits(chunk, y, z, is_unknown)) << 1;
+            let inner = u32::from(row_bits(chunk, y, z, Voxel::is_unknown)) << 1;
             let low = u32::from(unknown_voxel(nx, EDGE - 1, y, z));
             let high = u32::from(unknown_voxel(px, 0, y, z)) << (EDGE + 1);
             unknown[z + 1][y + 1] = inner | low | high;

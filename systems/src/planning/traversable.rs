@@ -31,7 +31,7 @@
 use super::lattice::Lattice;
 use crate::mapping::OccupancyMap;
 use glam::{DVec3, IVec3};
-use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, floor_to_key};
+use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, Voxel, floor_to_key};
 
 /// Largest inflation, in voxels: a chunk plus its halo and one voxel more must fit a 64-bit
 /// row (16 + 2 x (23 + 1)). Larger radii are clamped (2.3 m at 0.1 m, far beyond any UAV).
@@ -330,8 +330,7 @@ impl TraversableGrid {
                     continue;
                 }
                 let row = (ly + EDGE * lz) as usize;
-                // Free: known (not i16::MIN) with l < 0.
-                let bits = chunk.row_bits(row, |v| v.log_odds < 0 && v.log_odds != i16::MIN);
+                let bits = chunk.row_bits(row, Voxel::is_free);
                 rows[row] = bits & x_mask;
             }
         }
@@ -463,11 +462,10 @@ impl TraversableGrid {
                             let local_row = ((y - c_first.y) + EDGE * (z - c_first.z)) as usize;
                             let i = (y - halo_min.y) as usize + gw * (z - halo_min.z) as usize;
                             let assumed_row = assumed.map_or(0, |a| a[local_row]);
-                            // Occupied: l >= 0 (the unknown marker `i16::MIN` is negative).
                             let (known, occupied) = chunk.map_or((0, 0), |chunk| {
                                 (
-                                    chunk.row_bits(local_row, |v| v.log_odds != i16::MIN),
-                                    chunk.row_bits(local_row, |v| v.log_odds >= 0),
+                                    !chunk.row_bits(local_row, Voxel::is_unknown),
+                                    chunk.row_bits(local_row, Voxel::is_occupied),
                                 )
                             });
                             // An assumed-free voxel is known and not occupied, whatever the map

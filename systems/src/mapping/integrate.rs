@@ -250,8 +250,8 @@ impl<C: ChunkAccess> Integration<'_, C> {
     /// - in a brick of saturated free voxels the walk crosses the largest saturated cube
     ///   around it (brick, block or chunk) in one move ([`cross_saturated`]), as long as a
     ///   miss cannot change them (a non-positive miss increment) and the cube's face comes
-    ///   before `t_safe`; a saturated voxel in a brick that is not full is passed over
-    ///   alone, unstamped (misses only).
+    ///   before `t_safe` (a saturated voxel in a brick that is not full costs one compare:
+    ///   [`update_voxel`]).
     ///
     /// No lookups, no bounds checks.
     fn walk_fast(
@@ -270,9 +270,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let mut stop = false;
         // Saturated voxels stay unchanged by a non-positive increment only (a miss, always in
         // practice).
-        let misses_saturate = rule.delta <= 0;
-        let saturated = rule.min as i16;
-        let mut cubes_left = if misses_saturate {
+        let mut cubes_left = if rule.delta <= 0 {
             CubeLimit::ANY
         } else {
             CubeLimit::NONE
@@ -351,14 +349,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
                         continue;
                     }
                 }
-                // A saturated voxel is left as it is, unstamped: the miss cannot change it, and
-                // any later visit of this scan finds it saturated again (a brick partly
-                // outside the frustum never fills, so a camera at rest meets many such voxels).
-                if !(misses_saturate && voxels[index].log_odds == saturated) {
-                    let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
-                    changed += u64::from(change.changed());
-                    states_changed |= change.state_changed();
-                }
+                let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
+                changed += u64::from(change.changed());
+                states_changed |= change.state_changed();
                 visits -= 1;
                 if visits == 0 {
                     break;

@@ -39,7 +39,8 @@ impl VoxelChange {
     }
 }
 
-/// Applies `rule` to voxel `index` of a chunk's `voxels` unless this scan already updated it:
+/// Applies `rule` to voxel `index` of a chunk's `voxels` unless this scan already updated it
+/// (or it is saturated and `rule` a miss, which changes nothing):
 /// stamps it, adds the increment to its log-odds (an unknown voxel starts from l = 0, p = 0.5),
 /// clamps, and keeps `stats` in step (old value out, new value in), and `saturation`, which
 /// voxels are at the lower bound ([`BrickSaturation`]).
@@ -53,6 +54,12 @@ pub fn update_voxel(
     stats: &mut StatSums,
 ) -> VoxelChange {
     let voxel = &mut voxels[index % CHUNK_VOXELS];
+    // A saturated voxel is left as it is, unstamped, by a non-positive increment (a miss): it
+    // cannot change, and any later visit of this scan finds it saturated again. (A brick
+    // partly outside the frustum never fills, so a camera at rest walks many such voxels.)
+    if rule.delta <= 0 && i32::from(voxel.log_odds) == rule.min {
+        return VoxelChange::None;
+    }
     if voxel.stamp == rule.stamp {
         return VoxelChange::None;
     }

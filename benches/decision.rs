@@ -16,7 +16,8 @@
 //! a digest of every planned candidate (target, viewpoint, trajectory bits), so that a change
 //! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
 //! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
-//! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_LOOPS=n` replays the planning
+//! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_TOP=n` lists the n slowest
+//! decisions with their parts; `DECISION_LOOPS=n` replays the planning
 //! n more times (for `perf record`); `DECISION_PAUSE_S=s` prints a line and waits `s` seconds
 //! between the mission and the replay (to switch a profiler on for the replay alone: under
 //! valgrind the mission takes an hour instrumented, a few minutes not).
@@ -199,6 +200,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(0);
+    let top: usize = std::env::var("DECISION_TOP")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(0);
     let pause = std::env::var("DECISION_PAUSE_S")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -231,6 +236,7 @@ fn main() {
             (vec![], vec![], vec![], vec![], vec![]);
         let mut candidates = 0usize;
         let mut targets = 0usize;
+        let mut rows = Vec::new();
         for (k, s) in snapshots.iter().enumerate() {
             let (t_ms, planned) = pool.install(|| fastest_ms(|| plan(s)));
             let (e_ms, _) = pool.install(|| {
@@ -256,6 +262,15 @@ fn main() {
                 )
                 .expect("digest written");
             }
+            rows.push((
+                s.clustering_ms + t_ms + e_ms,
+                k,
+                s.clusters.len(),
+                planned.len(),
+                s.clustering_ms,
+                t_ms,
+                e_ms,
+            ));
             clustering.push(s.clustering_ms);
             trajectories.push(t_ms);
             energy.push(e_ms);
@@ -274,6 +289,13 @@ fn main() {
             targets as f64 / n,
             candidates as f64 / n
         );
+        rows.sort_by(|a, b| b.0.total_cmp(&a.0));
+        for (total, k, clusters, planned, c, t, e) in rows.iter().take(top) {
+            println!(
+                "  decision {k:3}: {total:7.2} ms ({clusters} clusters, {planned} planned): \
+                 clustering {c:.2}, trajectories {t:.2}, energy {e:.2}"
+            );
+        }
         for (name, v) in [
             ("total", totals),
             ("clustering (in place)", clustering),

@@ -8,6 +8,7 @@ pub mod collision;
 pub mod limits;
 pub mod min_snap;
 pub mod planner;
+pub mod retime;
 
 #[cfg(test)]
 mod tests;

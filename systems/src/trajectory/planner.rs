@@ -4,12 +4,13 @@
 //! Time allocation: each segment starts with the time a rest-to-rest trapezoidal profile at
 //! (vmax, amax) would take over its straight length (and enough to turn the yaw at
 //! `max_yaw_rate`), which sets the segments' proportions. The minimum-snap solution then gets
-//! its exact peaks ([`super::limits`]), and every duration is scaled by the worst excess ratio
-//! `max(v/vmax, sqrt(a/amax))`. Uniform scaling keeps the shape of the path: from rest, speed
-//! scales as 1/s and acceleration as 1/s^2 exactly, so one round lands on the binding limit;
-//! from a moving start (whose velocity does not scale) a few rounds are needed. A solution
-//! slower than needed is tightened the same way. (Stretching only the offending segments
-//! does not work: a long segment between short ones bulges, and its peaks grow.)
+//! its exact peaks ([`super::limits`]), and every duration is scaled until the worst excess
+//! ratio `max(v/vmax, sqrt(a/amax))` is just within 1 ([`super::retime`]). Uniform scaling
+//! keeps the shape of the path: from rest, speed scales as 1/s and acceleration as 1/s^2
+//! exactly, so one round lands on the binding limit; from a moving start (whose velocity does
+//! not scale) a secant search takes a few. A solution slower than needed is tightened the
+//! same way. (Stretching only the offending segments does not work: a long segment between
+//! short ones bulges, and its peaks grow.)
 //!
 //! Collisions: when a segment of the solution crosses a blocked point, the midpoint of that
 //! segment's straight chord is added as a waypoint and the problem solved again (Richter et
@@ -19,6 +20,7 @@ use super::PlanError;
 use super::collision::first_blocked;
 use super::limits::worst_ratio;
 use super::min_snap::{JointConstraints, build_segments, solve_joint_derivatives, solve_outputs};
+use super::retime::{MARGIN, ScaleSearch, Step};
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 use uavex_components::airframe::Airframe;
@@ -84,8 +86,6 @@ impl DynamicLimits {
 
 /// Rescaling rounds: one suffices from rest (exact scaling); a moving start needs a few.
 const MAX_ROUNDS: usize = 30;
-/// Ratios are pushed this far below 1 so that rounding never leaves a peak a hair above a limit.
-const MARGIN: f64 = 1.0 + 1e-6;
 
 /// Minimum-snap trajectory from `start` through `waypoints`, ending at rest, whose speed and
 /// acceleration stay within `limits` everywhere.
@@ -105,16 +105,20 @@ pub fn plan_min_snap(
     }
     let yaws = unwrapped_yaws(start.yaw, waypoints);
     let mut durations = initial_durations(start, waypoints, &yaws, limits)?;
+    let mut search = ScaleSearch::new();
     for _ in 0..MAX_ROUNDS {
         let mut outputs = solve_position(start, waypoints, &durations)?;
         let worst = limits.worst_ratio(&trajectory_of(&durations, &outputs)?, 0.0);
-        if worst <= 1.0 {
-            return match tighten(start, waypoints, &yaws, &durations, worst, limits) {
-                Some(tightened) => Ok(tightened),
-                None => with_yaw(start, &yaws, &durations, &mut outputs),
-            };
+        match search.step(worst) {
+            Step::Accept => {
+                return match tighten(start, waypoints, &yaws, &durations, worst, limits) {
+                    Some(tightened) => Ok(tightened),
+                    None => with_yaw(start, &yaws, &durations, &mut outputs),
+                };
+            }
+            Step::Scale(factor) => durations.iter_mut().for_each(|d| *d *= factor),
+            Step::GiveUp => break,
         }
-        durations.iter_mut().for_each(|d| *d *= worst * MARGIN);
     }
     Err(PlanError::LimitsUnreachable)
 }

@@ -197,7 +197,7 @@ mod tests {
             assert_eq!(fixed_point_rounds(ratio), fixed_point, "c {c} e {e}");
             let (scale, rounds) = search(ratio).expect("accepted");
             let r = ratio(scale);
-            assert!(r <= 1.0 && r >= 1.0 - TOLERANCE, "c {c} e {e}: r {r}");
+            assert!((1.0 - TOLERANCE..=1.0).contains(&r), "c {c} e {e}: r {r}");
             assert!(rounds <= 5, "c {c} e {e}: {rounds} rounds");
         }
         // Falling faster than 1/s: the fixed-point step overshoots, and is brought back.
@@ -217,7 +217,7 @@ mod tests {
         let (scale, rounds) = search(ratio).expect("accepted");
         let r = ratio(scale);
         assert!(
-            r <= 1.0 && r >= 1.0 - TOLERANCE,
+            (1.0 - TOLERANCE..=1.0).contains(&r),
             "r {r} after {rounds} rounds"
         );
         assert!(rounds <= 10, "{rounds} rounds");

@@ -14,7 +14,7 @@
 use super::budget::return_energies;
 use super::propose::{ClusterTarget, MAX_EXPANSIONS, PlannedCandidate};
 use crate::flight::{FlightState, RolloutConfig, RolloutResult, rollout};
-use crate::planning::{TraversableGrid, find_paths, plan_along};
+use crate::planning::{SightMemo, TraversableGrid, find_paths, plan_along_seen};
 use crate::trajectory::DynamicLimits;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -55,7 +55,8 @@ impl TargetPaths {
 /// for), in parallel, results in the order of `which`: the trajectory to a target's centroid,
 /// or failing that to each of its viewpoints in turn; targets without a feasible trajectory
 /// are left out. Goals within `min_travel_m` of the start are skipped: flying there gains
-/// nothing.
+/// nothing. The plans of each parallel job share one line-of-sight memo: the paths come from
+/// one search tree and ask the same questions ([`crate::planning::sight`]).
 pub fn plan_targets(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -67,32 +68,36 @@ pub fn plan_targets(
 ) -> Vec<PlannedCandidate> {
     which
         .par_iter()
-        .filter_map(|&index| {
-            let target = &targets[index];
-            let first = paths.first_goal[index];
-            let options = std::iter::once((None, None)).chain(
-                target
-                    .viewpoints
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| (Some(i), Some(f64::from(v.yaw)))),
-            );
-            options.enumerate().find_map(|(k, (viewpoint, yaw))| {
-                let path = paths.paths[first + k].as_ref()?;
-                if paths.goals[first + k].distance(start.position) <= min_travel_m {
-                    return None;
-                }
-                let plan = plan_along(grid, start, path, yaw, limits).ok()?;
-                let end = plan.trajectory.sample(plan.trajectory.duration());
-                Some(PlannedCandidate {
-                    target: index,
-                    goal: end.position,
-                    goal_yaw: end.yaw,
-                    plan,
-                    viewpoint,
+        .map_init(
+            || SightMemo::new(grid),
+            |sight, &index| {
+                let target = &targets[index];
+                let first = paths.first_goal[index];
+                let options = std::iter::once((None, None)).chain(
+                    target
+                        .viewpoints
+                        .iter()
+                        .enumerate()
+                        .map(|(i, v)| (Some(i), Some(f64::from(v.yaw)))),
+                );
+                options.enumerate().find_map(|(k, (viewpoint, yaw))| {
+                    let path = paths.paths[first + k].as_ref()?;
+                    if paths.goals[first + k].distance(start.position) <= min_travel_m {
+                        return None;
+                    }
+                    let plan = plan_along_seen(sight, start, path, yaw, limits).ok()?;
+                    let end = plan.trajectory.sample(plan.trajectory.duration());
+                    Some(PlannedCandidate {
+                        target: index,
+                        goal: end.position,
+                        goal_yaw: end.yaw,
+                        plan,
+                        viewpoint,
+                    })
                 })
-            })
-        })
+            },
+        )
+        .flatten()
         .collect()
 }
 

@@ -17,6 +17,7 @@
 
 use super::check::first_untraversable_polynomial;
 use super::search::{MIN_POINT_SEPARATION_M, find_path, path_length, shortcut_indices};
+use super::sight::SightMemo;
 use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::follow_headings;
 use crate::trajectory::{DynamicLimits, PlanError, Waypoint, plan_min_snap};
@@ -46,6 +47,20 @@ pub fn plan_along(
     end_yaw: Option<f64>,
     limits: &DynamicLimits,
 ) -> Result<GlobalPlan, PlanError> {
+    plan_along_seen(&mut SightMemo::new(grid), start, path, end_yaw, limits)
+}
+
+/// [`plan_along`] on the grid of `sight`, asking it the lines of sight of the path's
+/// shortening: the plans of one decision share one memo, and its paths most of their
+/// questions (see [`super::sight`]).
+pub fn plan_along_seen(
+    sight: &mut SightMemo,
+    start: &TrajectoryPoint,
+    path: &[DVec3],
+    end_yaw: Option<f64>,
+    limits: &DynamicLimits,
+) -> Result<GlobalPlan, PlanError> {
+    let grid = sight.grid();
     if let Some(i) = path.iter().position(|p| !p.is_finite()) {
         return Err(PlanError::NonFinite(format!("path point {i}")));
     }
@@ -59,7 +74,12 @@ pub fn plan_along(
     if original.len() < 2 {
         return Err(PlanError::NoWaypoints);
     }
-    let kept = beyond_stopping(&shortcut_indices(grid, &original), &original, start, limits);
+    let kept = beyond_stopping(
+        &shortcut_indices(sight, &original),
+        &original,
+        start,
+        limits,
+    );
     let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
     let trajectory = fit(grid, start, &original, &kept, end_yaw, limits)?;
     Ok(GlobalPlan {

@@ -20,6 +20,7 @@ pub mod global;
 pub mod lattice;
 pub mod local;
 pub mod search;
+pub mod sight;
 pub mod traversable;
 
 #[cfg(test)]
@@ -31,9 +32,10 @@ pub use check::{
     first_untraversable, first_untraversable_polynomial, polynomial_position, refresh_along,
     remains_traversable,
 };
-pub use global::{GlobalPlan, plan_along, plan_global};
+pub use global::{GlobalPlan, plan_along, plan_along_seen, plan_global};
 pub use local::{LocalPlan, plan_local};
 pub use search::{SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
+pub use sight::SightMemo;
 pub use traversable::TraversableGrid;
 
 use crate::mapping::StateChanges;

@@ -16,6 +16,7 @@
 //! tried in a fixed order; no hash map is iterated.
 
 use super::lattice::{Lattice, MAX_LATTICE_CELLS, MOVE_COSTS};
+use super::sight::SightMemo;
 use super::traversable::TraversableGrid;
 use glam::{DVec3, IVec3};
 use std::cell::RefCell;
@@ -454,8 +455,8 @@ pub fn find_paths(
     result
 }
 
-/// Indices of the points [`shortcut`] keeps.
-pub(crate) fn shortcut_indices(grid: &TraversableGrid, path: &[DVec3]) -> Vec<usize> {
+/// Indices of the points [`shortcut`] keeps, the lines of sight asked of `sight`.
+pub(crate) fn shortcut_indices(sight: &mut SightMemo, path: &[DVec3]) -> Vec<usize> {
     if path.len() <= 2 {
         return (0..path.len()).collect();
     }
@@ -463,7 +464,7 @@ pub(crate) fn shortcut_indices(grid: &TraversableGrid, path: &[DVec3]) -> Vec<us
     let mut kept = vec![0];
     let mut anchor = 0;
     for j in 1..last {
-        if !grid.line_of_sight(path[anchor], path[j + 1]) {
+        if !sight.line_of_sight(path[anchor], path[j + 1]) {
             kept.push(j);
             anchor = j;
         }
@@ -478,7 +479,7 @@ pub(crate) fn shortcut_indices(grid: &TraversableGrid, path: &[DVec3]) -> Vec<us
 /// of a blocked start, for instance, which no chord can replace). The first and last points
 /// are kept.
 pub fn shortcut(grid: &TraversableGrid, path: &[DVec3]) -> Vec<DVec3> {
-    shortcut_indices(grid, path)
+    shortcut_indices(&mut SightMemo::new(grid), path)
         .into_iter()
         .map(|i| path[i])
         .collect()

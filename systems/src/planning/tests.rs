@@ -448,3 +448,39 @@ fn a_ball_assumed_free_is_traversable_where_it_holds_the_whole_inflation() {
         assert_eq!(grid.is_traversable(centre + offset), expected, "{offset}");
     }
 }
+
+#[test]
+fn the_sight_memo_answers_as_the_grid_does_and_asks_each_question_once() {
+    let mut map = wall_room();
+    let grid = map.grid(0.0);
+    let mut sight = SightMemo::new(&grid);
+    let mut rng = ChaCha8Rng::seed_from_u64(7);
+    let mut point = || {
+        DVec3::new(
+            rng.random_range(0.0..6.4),
+            rng.random_range(0.0..6.4),
+            rng.random_range(0.0..1.6),
+        )
+    };
+    let pairs: Vec<(DVec3, DVec3)> = (0..300).map(|_| (point(), point())).collect();
+    let (mut seen, mut blocked) = (0, 0);
+    for round in 0..2 {
+        for &(a, b) in &pairs {
+            let expected = grid.line_of_sight(a, b);
+            assert_eq!(
+                sight.line_of_sight(a, b),
+                expected,
+                "round {round}: {a} -> {b}"
+            );
+            blocked += usize::from(!expected);
+            seen += 1;
+        }
+        // The second round adds no question: every answer comes from memory.
+        assert_eq!(sight.len(), pairs.len());
+    }
+    // Both answers occur (the wall at x = 3.0-3.2 m blocks about half the pairs).
+    assert!(
+        blocked > seen / 10 && blocked < seen * 9 / 10,
+        "{blocked} of {seen}"
+    );
+}

@@ -9,8 +9,9 @@
 //!    Goal: >= 100x.
 //!
 //! Whole missions take tens of seconds, so this is a plain timed program (`harness = false`),
-//! not a criterion loop: `cargo bench --bench exploration`. Each mission is run once per seed;
-//! the figures printed are what the README quotes.
+//! not a criterion loop: `cargo bench --bench exploration` (seeds 1 and 2;
+//! `EXPLORATION_SEEDS=3,4,5` for others). Each mission is run once per seed; the figures printed
+//! are what the README quotes.
 
 use std::time::Instant;
 use uavex_components::exploration::{DecisionLog, DecisionTiming, DecisionTimings};
@@ -33,7 +34,12 @@ fn main() {
     let shipped = load(path).unwrap_or_else(|e| panic!("{e}"));
 
     println!("exploration bench, one core (EAAE Pillars)");
-    for seed in [1u64, 2] {
+    // `EXPLORATION_SEEDS=1,2,3` picks the seeds (default 1, 2).
+    let seeds: Vec<u64> = std::env::var("EXPLORATION_SEEDS")
+        .ok()
+        .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![1, 2]);
+    for seed in seeds {
         // 1. Every cluster evaluated.
         let mut all = shipped.clone();
         if let BehaviourSpec::Explore(explore) = &mut all.scenario.uavs[0].behaviour {

@@ -163,11 +163,7 @@ fn digest(planned: &[PlannedCandidate]) -> u64 {
 }
 
 fn fastest_ms<T>(mut f: impl FnMut() -> T) -> (f64, T) {
-    let repeats = std::env::var("DECISION_REPEATS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(REPEATS)
-        .max(1);
+    let repeats = env_number("DECISION_REPEATS").unwrap_or(REPEATS).max(1);
     let mut best = f64::INFINITY;
     let mut out = None;
     for _ in 0..repeats {
@@ -185,6 +181,11 @@ fn quantiles(mut v: Vec<f64>) -> (f64, f64, f64) {
     (q(0.5), q(0.95), v.last().copied().unwrap_or(0.0))
 }
 
+/// The number in environment variable `name`, if set and well formed.
+fn env_number<T: std::str::FromStr>(name: &str) -> Option<T> {
+    std::env::var(name).ok().and_then(|s| s.parse().ok())
+}
+
 fn main() {
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
@@ -196,18 +197,9 @@ fn main() {
         .ok()
         .map(|s| s.split(',').filter_map(|x| x.trim().parse().ok()).collect())
         .unwrap_or_else(|| vec![1]);
-    let loops: usize = std::env::var("DECISION_LOOPS")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
-    let top: usize = std::env::var("DECISION_TOP")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .unwrap_or(0);
-    let pause = std::env::var("DECISION_PAUSE_S")
-        .ok()
-        .and_then(|s| s.parse().ok())
-        .map(std::time::Duration::from_secs_f64);
+    let loops: usize = env_number("DECISION_LOOPS").unwrap_or(0);
+    let top: usize = env_number("DECISION_TOP").unwrap_or(0);
+    let pause = env_number("DECISION_PAUSE_S").map(std::time::Duration::from_secs_f64);
     let mut digest_file = std::env::var("DECISION_DIGEST")
         .ok()
         .map(|p| std::fs::File::create(p).expect("a writable digest file"));

@@ -47,7 +47,14 @@ pub fn plan_along(
     end_yaw: Option<f64>,
     limits: &DynamicLimits,
 ) -> Result<GlobalPlan, PlanError> {
-    plan_along_seen(&mut SightMemo::new(grid), start, path, end_yaw, limits)
+    plan_along_by(
+        grid,
+        |a, b| grid.line_of_sight(a, b),
+        start,
+        path,
+        end_yaw,
+        limits,
+    )
 }
 
 /// [`plan_along`] on the grid of `sight`, asking it the lines of sight of the path's
@@ -61,6 +68,19 @@ pub fn plan_along_seen(
     limits: &DynamicLimits,
 ) -> Result<GlobalPlan, PlanError> {
     let grid = sight.grid();
+    let sees = |a, b| sight.line_of_sight(a, b);
+    plan_along_by(grid, sees, start, path, end_yaw, limits)
+}
+
+/// [`plan_along`] with `sees(a, b)` the line of sight of the shortening.
+fn plan_along_by(
+    grid: &TraversableGrid,
+    sees: impl FnMut(DVec3, DVec3) -> bool,
+    start: &TrajectoryPoint,
+    path: &[DVec3],
+    end_yaw: Option<f64>,
+    limits: &DynamicLimits,
+) -> Result<GlobalPlan, PlanError> {
     if let Some(i) = path.iter().position(|p| !p.is_finite()) {
         return Err(PlanError::NonFinite(format!("path point {i}")));
     }
@@ -74,12 +94,7 @@ pub fn plan_along_seen(
     if original.len() < 2 {
         return Err(PlanError::NoWaypoints);
     }
-    let kept = beyond_stopping(
-        &shortcut_indices(sight, &original),
-        &original,
-        start,
-        limits,
-    );
+    let kept = beyond_stopping(&shortcut_indices(&original, sees), &original, start, limits);
     let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
     let trajectory = fit(grid, start, &original, &kept, end_yaw, limits)?;
     Ok(GlobalPlan {

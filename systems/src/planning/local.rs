@@ -6,7 +6,6 @@
 
 use super::global::plan_along;
 use super::search::{MIN_POINT_SEPARATION_M, find_path, shortcut_indices};
-use super::sight::SightMemo;
 use super::traversable::TraversableGrid;
 use crate::trajectory::{DynamicLimits, PlanError};
 use glam::DVec3;
@@ -49,7 +48,7 @@ pub fn plan_local(
 /// kept one before the horizon, then the point of the chord at the horizon (on a chord of
 /// traversable voxels, so traversable itself). Returns whether the whole path was kept.
 fn truncate(grid: &TraversableGrid, path: Vec<DVec3>, horizon_m: f64) -> (Vec<DVec3>, bool) {
-    let kept = shortcut_indices(&mut SightMemo::new(grid), &path);
+    let kept = shortcut_indices(&path, |a, b| grid.line_of_sight(a, b));
     let mut travelled = 0.0;
     for pair in kept.windows(2) {
         let (a, b) = (path[pair[0]], path[pair[1]]);

@@ -16,7 +16,6 @@
 //! tried in a fixed order; no hash map is iterated.
 
 use super::lattice::{Lattice, MAX_LATTICE_CELLS, MOVE_COSTS};
-use super::sight::SightMemo;
 use super::traversable::TraversableGrid;
 use glam::{DVec3, IVec3};
 use std::cell::RefCell;
@@ -455,8 +454,12 @@ pub fn find_paths(
     result
 }
 
-/// Indices of the points [`shortcut`] keeps, the lines of sight asked of `sight`.
-pub(crate) fn shortcut_indices(sight: &mut SightMemo, path: &[DVec3]) -> Vec<usize> {
+/// Indices of the points [`shortcut`] keeps, with `sees(a, b)` the line of sight (the grid's
+/// own, or a [`super::SightMemo`]'s when plans share their questions).
+pub(crate) fn shortcut_indices(
+    path: &[DVec3],
+    mut sees: impl FnMut(DVec3, DVec3) -> bool,
+) -> Vec<usize> {
     if path.len() <= 2 {
         return (0..path.len()).collect();
     }
@@ -464,7 +467,7 @@ pub(crate) fn shortcut_indices(sight: &mut SightMemo, path: &[DVec3]) -> Vec<usi
     let mut kept = vec![0];
     let mut anchor = 0;
     for j in 1..last {
-        if !sight.line_of_sight(path[anchor], path[j + 1]) {
+        if !sees(path[anchor], path[j + 1]) {
             kept.push(j);
             anchor = j;
         }
@@ -479,7 +482,7 @@ pub(crate) fn shortcut_indices(sight: &mut SightMemo, path: &[DVec3]) -> Vec<usi
 /// of a blocked start, for instance, which no chord can replace). The first and last points
 /// are kept.
 pub fn shortcut(grid: &TraversableGrid, path: &[DVec3]) -> Vec<DVec3> {
-    shortcut_indices(&mut SightMemo::new(grid), path)
+    shortcut_indices(path, |a, b| grid.line_of_sight(a, b))
         .into_iter()
         .map(|i| path[i])
         .collect()

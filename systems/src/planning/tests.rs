@@ -356,6 +356,78 @@ fn find_paths_agrees_with_find_path_on_random_maps() {
     }
 }
 
+/// The pruning of the searches (`search::relaxed_by_parent`), bit by bit: it is linear in the
+/// parent's moves, so one parent move at a time covers every case. From a cell reached by move
+/// `d`, move `e` is skipped exactly when the parent allows `d + e`.
+#[test]
+fn a_parents_moves_prune_the_moves_they_already_relaxed() {
+    let grid = TestMap::new(DVec3::ZERO, DVec3::ONE).grid(0.1);
+    let moves = grid.lattice().moves();
+    for (k, d) in moves.iter().enumerate() {
+        for (j, f) in moves.iter().enumerate() {
+            let expected = moves
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.delta + d.delta == f.delta)
+                .fold(0u32, |bits, (i, _)| bits | 1 << i);
+            assert_eq!(
+                search::relaxed_by_parent(k, 1 << j),
+                expected,
+                "arrival {}, parent move {}",
+                d.delta,
+                f.delta
+            );
+        }
+    }
+}
+
+/// The pruned Dijkstra's costs are the shortest lattice distances: every reached cell's cost
+/// is no more than any neighbour's plus the move (so no improving relaxation was skipped), and
+/// equals one of them (or is the start's 0).
+#[test]
+fn pruned_searches_keep_every_cost_shortest() {
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for _ in 0..3 {
+        let mut map = TestMap::new(DVec3::ZERO, DVec3::new(4.8, 4.8, 2.4));
+        map.fill_all(FREE);
+        for _ in 0..10 {
+            let lo = IVec3::new(
+                rng.random_range(0..44),
+                rng.random_range(0..44),
+                rng.random_range(0..20),
+            );
+            let size = IVec3::new(
+                rng.random_range(1..10),
+                rng.random_range(1..10),
+                rng.random_range(1..16),
+            );
+            map.fill(lo, lo + size, OCCUPIED);
+        }
+        let grid = map.grid(0.15);
+        let lattice = grid.lattice();
+        let start = (0..lattice.len())
+            .find(|&c| lattice.is_open(c))
+            .expect("an open cell");
+        let costs = search::all_costs(lattice, start);
+        let mut reached = 0;
+        for cell in (0..lattice.len()).filter(|&c| costs[c] != u64::MAX) {
+            reached += 1;
+            let mut allowed = lattice.allowed_moves(cell);
+            let mut via = u64::MAX;
+            while allowed != 0 {
+                let mv = &lattice.moves()[allowed.trailing_zeros() as usize];
+                allowed &= allowed - 1;
+                let next = cell.wrapping_add_signed(mv.offset);
+                assert!(costs[next] <= costs[cell] + mv.cost, "cell {cell}");
+                // Moves are symmetric: `next` reaches `cell` by the opposite move.
+                via = via.min(costs[next].saturating_add(mv.cost));
+            }
+            assert!(cell == start || costs[cell] == via, "cell {cell}");
+        }
+        assert!(reached > 1000, "{reached} cells reached");
+    }
+}
+
 #[test]
 fn a_blocked_start_is_attached_to_the_nearest_open_cell() {
     let mut map = wall_room();

@@ -15,17 +15,17 @@
 use super::apply::apply_overrides;
 use super::expand::{RunSpec, Shard, expand};
 use super::plan::Plan;
+use super::schedule::RunQueue;
 use crate::output::write_atomically;
 use crate::run::{RunOptions, run as run_scenario};
 use crate::scenario::parse_str;
 use indicatif::{ProgressBar, ProgressStyle};
-use rayon::prelude::*;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::panic::{AssertUnwindSafe, catch_unwind};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use std::time::Duration;
+use std::sync::{Mutex, MutexGuard};
+use std::time::{Duration, Instant};
 use thiserror::Error;
 use uavex_components::sim::Outcome;
 
@@ -171,20 +171,32 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
         .num_threads(options.jobs.max(1))
         .build()
         .map_err(|e| SweepError::Pool(e.to_string()))?;
-    pool.install(|| {
-        todo.par_iter().for_each(|run| {
+    // Runs that differ only in their seed form a group (see `schedule`).
+    let groups: Vec<_> = todo
+        .iter()
+        .map(|run| (&run.scenario_file, &run.coordinates))
+        .collect();
+    let queue = Mutex::new(RunQueue::new(&groups));
+    let take = || lock(&queue).take();
+    // One worker per thread of the pool, each taking the next run until none is left; the
+    // runs' own parallel parts (a decision's plans and rollouts) share the pool.
+    pool.broadcast(|_| {
+        while let Some(next) = take() {
+            let run = &todo[next];
             let text = &texts[run.scenario_file.as_path()];
             let dir = runs_dir.join(&run.id);
+            let started = Instant::now();
             let ending = execute_run(run, text, &dir, options.run_wall_limit);
+            lock(&queue).finished(next, started.elapsed());
             if let Err(reason) = &ending {
                 let first_line = reason.lines().next().unwrap_or_default();
                 bar.println(format!("run {} failed: {first_line}", run.id));
-                let mut failed = failed.lock().unwrap_or_else(|e| e.into_inner());
+                let mut failed = lock(&failed);
                 failed.push((run.index, run.id.clone(), reason.clone()));
                 bar.set_message(format!("{} failed", failed.len()));
             }
             bar.inc(1);
-        });
+        }
     });
     // The report printed after the sweep says what the bar said.
     bar.finish_and_clear();
@@ -194,6 +206,12 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
     report.ran = todo.len();
     report.failed = failed.into_iter().map(|(_, id, why)| (id, why)).collect();
     Ok(report)
+}
+
+/// The data behind `mutex`, also after a panic elsewhere (a run's panic is caught and
+/// recorded; the sweep goes on).
+fn lock<T>(mutex: &Mutex<T>) -> MutexGuard<'_, T> {
+    mutex.lock().unwrap_or_else(|e| e.into_inner())
 }
 
 /// True when the run in `dir` has finished (its summary exists).

@@ -5,7 +5,7 @@
 //! - [`plan`]: the plan file (TOML) and its checks;
 //! - [`path`] and [`apply`]: field paths and how an override edits a scenario's text;
 //! - [`expand`](mod@expand): runs, their ids, shards;
-//! - [`execute`]: running a plan into a results folder;
+//! - [`execute`]: running a plan into a results folder, with [`schedule`] ordering the runs;
 //! - [`merge`](mod@merge): joining shard folders.
 //!
 //! A run is a pure function of its scenario (with overrides) and seed, and nothing a run
@@ -18,6 +18,7 @@ pub mod expand;
 pub mod merge;
 pub mod path;
 pub mod plan;
+pub mod schedule;
 
 pub use apply::{Override, OverrideError, apply_overrides};
 pub use execute::{SweepError, SweepOptions, SweepReport, is_finished, run_sweep};

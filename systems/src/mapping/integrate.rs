@@ -18,6 +18,7 @@ use super::cube::{Cube, CubeLimit, cross_cube, cross_saturated};
 use super::dda::{SegmentClipper, T_ONE, VoxelWalk, to_fixed};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
+use std::cell::RefCell;
 use uavex_components::map::{
     CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
     StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
@@ -60,6 +61,12 @@ impl<'a> ScanRays<'a> {
             hit: &scan.hit,
         }
     }
+}
+
+thread_local! {
+    /// The rays' end points in voxel units (hits nudged, see [`end_point`]), kept on each
+    /// thread from one scan to the next so that integrating a scan allocates nothing.
+    static ENDS: RefCell<Vec<DVec3>> = const { RefCell::new(Vec::new()) };
 }
 
 /// What one integration did.
@@ -119,35 +126,39 @@ pub fn integrate_scan(
         },
     };
     let origin = config.to_voxel_units(rays.origin);
-    let ends = || {
-        rays.endpoints
-            .iter()
-            .zip(rays.hit)
-            .map(|(&p, &hit)| (end_point(origin, config.to_voxel_units(p), hit), hit))
-    };
+    ENDS.with_borrow_mut(|ends| {
+        // Both passes read every hit's end: computed once (a square root and a division each).
+        ends.clear();
+        ends.extend(
+            rays.endpoints
+                .iter()
+                .zip(rays.hit)
+                .map(|(&p, &hit)| end_point(origin, config.to_voxel_units(p), hit)),
+        );
 
-    // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
-    let hit_rule = rule(increments.hit);
-    for (end, _) in ends().filter(|&(_, hit)| hit) {
-        let key = floor_to_key(end);
-        if config.contains_key(key) {
-            run.report.voxel_visits += 1;
-            run.update_one(key, hit_rule);
+        // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
+        let hit_rule = rule(increments.hit);
+        for (&end, _) in ends.iter().zip(rays.hit).filter(|&(_, &hit)| hit) {
+            let key = floor_to_key(end);
+            if config.contains_key(key) {
+                run.report.voxel_visits += 1;
+                run.update_one(key, hit_rule);
+            }
         }
-    }
 
-    // Pass 2: free space along every ray, skipping voxels this scan already updated.
-    let miss_rule = rule(increments.miss);
-    let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
-    for (end, hit) in ends() {
-        let Some(clip) = clipper.clip(end) else {
-            continue;
-        };
-        let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
-        let exclude_end = hit && clip.end_inside;
-        let visits = walk.steps_left() + 1 - u64::from(exclude_end);
-        run.update_walk(walk, clip.t_end, visits, miss_rule);
-    }
+        // Pass 2: free space along every ray, skipping voxels this scan already updated.
+        let miss_rule = rule(increments.miss);
+        let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
+        for (&end, &hit) in ends.iter().zip(rays.hit) {
+            let Some(clip) = clipper.clip(end) else {
+                continue;
+            };
+            let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
+            let exclude_end = hit && clip.end_inside;
+            let visits = walk.steps_left() + 1 - u64::from(exclude_end);
+            run.update_walk(walk, clip.t_end, visits, miss_rule);
+        }
+    });
     Ok(run.report)
 }
 

@@ -41,7 +41,9 @@ impl RunQueue {
         let group_of: Vec<usize> = groups
             .iter()
             .map(|g| {
-                labels.iter().position(|l| *l == g).unwrap_or_else(|| {
+                // Plans list a group's seeds one after another: the last group first.
+                let found = labels.iter().rposition(|l| *l == g);
+                found.unwrap_or_else(|| {
                     labels.push(g);
                     labels.len() - 1
                 })

@@ -6,7 +6,7 @@
 //!    (clustering, trajectory generation, energy estimation). Goal: p95 <= 20 ms.
 //! 2. whole-mission real-time factor of the shipped `eaae` Pillars run (simulated time / wall
 //!    time, everything included: sensing, mapping, frontiers, decisions, planning, physics).
-//!    Goal: >= 100x.
+//!    Goal: >= 100x. The wall time is also split by stage of the tick (`StageClock`).
 //!
 //! Whole missions take tens of seconds, so this is a plain timed program (`harness = false`),
 //! not a criterion loop: `cargo bench --bench exploration` (seeds 1 and 2;
@@ -19,6 +19,8 @@ use uavex_engine::exploration::log::percentile;
 use uavex_engine::exploration::{AllCandidates, CandidateCount};
 use uavex_engine::scenario::{BehaviourSpec, load};
 use uavex_engine::sim::Sim;
+use uavex_systems::stage_clock::StageClock;
+use uavex_systems::stages::Stage;
 
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     percentile(sorted, q).unwrap_or(f64::NAN)
@@ -81,5 +83,15 @@ fn main() {
              real-time factor {:.1}x, {outcome:?}",
             simulated / wall
         );
+        // Where that wall time went, stage by stage (the run's `stage_timings.csv`).
+        let clock = sim.world.resource::<StageClock>();
+        let stages: Vec<String> = Stage::ORDER
+            .into_iter()
+            .map(|stage| {
+                let spent = clock.spent(stage).as_secs_f64();
+                format!("{stage:?} {spent:.2} s ({:.1} %)", 100.0 * spent / wall)
+            })
+            .collect();
+        println!("  stages: {}", stages.join(", "));
     }
 }

@@ -101,6 +101,26 @@ kind = "depth_camera"
     for file in ["series.csv", "uavs.csv", "map.bt", "map_occupied.ply"] {
         assert!(out_dir.join(file).metadata().unwrap().len() > 0, "{file}");
     }
+    // The host's time per stage: every stage once, in tick order, with shares summing to
+    // 100 %; this run senses and maps, so those stages took time.
+    let timings = std::fs::read_to_string(out_dir.join("stage_timings.csv")).unwrap();
+    let rows: Vec<Vec<&str>> = timings.lines().map(|l| l.split(',').collect()).collect();
+    assert_eq!(
+        rows[0],
+        ["stage", "wall_s", "share_pct", "mean_us_per_tick"]
+    );
+    let stages: Vec<&str> = rows[1..].iter().map(|r| r[0]).collect();
+    let order = [
+        "sense", "map", "frontier", "decide", "adapt", "plan", "control", "physics", "account",
+    ];
+    assert_eq!(stages, order, "{timings}");
+    let number = |r: &Vec<&str>, i: usize| r[i].parse::<f64>().unwrap();
+    let shares: f64 = rows[1..].iter().map(|r| number(r, 2)).sum();
+    assert!((shares - 100.0).abs() < 0.1, "{timings}");
+    assert!(
+        number(&rows[1], 1) > 0.0 && number(&rows[2], 1) > 0.0,
+        "{timings}"
+    );
 }
 
 /// A build without the `record` feature refuses `--record` (exit code 2, naming the feature)

@@ -1,5 +1,6 @@
 //! Files a run writes: `summary.json`, `series.csv` (map metrics over time), `uavs.csv` (tracks,
-//! with power and rotor speeds of dynamic UAVs; empty cells for kinematic ones).
+//! with power and rotor speeds of dynamic UAVs; empty cells for kinematic ones),
+//! `stage_timings.csv` (the host's wall-clock time per stage of the tick).
 //! Every file is written to a temporary name and renamed, so a reader never sees half a file.
 
 use crate::metrics::{MapRow, UavRow};
@@ -10,6 +11,8 @@ use std::path::Path;
 use uavex_components::sim::Outcome;
 use uavex_components::uav::PredictedMission;
 use uavex_systems::flight::EnergySummary;
+use uavex_systems::stage_clock::StageClock;
+use uavex_systems::stages::Stage;
 
 /// Per-UAV part of the summary.
 ///
@@ -206,6 +209,26 @@ pub fn uav_series_csv(rows: &[UavRow]) -> String {
             w(w2),
             w(w3),
         );
+    }
+    out
+}
+
+/// The wall-clock time of each stage of the tick as CSV, one row per stage in tick order: the
+/// time (s), its share of all stages (%) and its mean per tick (us). Host measurements, like
+/// the decision timings: they differ from machine to machine.
+pub fn stage_timings_csv(clock: &StageClock) -> String {
+    let mut out = String::from("stage,wall_s,share_pct,mean_us_per_tick\n");
+    let total = clock.total().as_secs_f64();
+    for stage in Stage::ORDER {
+        let spent = clock.spent(stage).as_secs_f64();
+        let share = if total > 0.0 {
+            100.0 * spent / total
+        } else {
+            0.0
+        };
+        let per_tick = 1e6 * spent / clock.ticks().max(1) as f64;
+        let name = format!("{stage:?}").to_lowercase();
+        let _ = writeln!(out, "{name},{spent:.6},{share:.2},{per_tick:.3}");
     }
     out
 }

@@ -6,7 +6,8 @@ use crate::exploration::{ExplorationSummary, decision_timings_csv, decisions_csv
 use crate::formats::{octomap, ply};
 use crate::metrics::{EXPLORED_THRESHOLDS, RunRecord};
 use crate::output::{
-    ExplorationKeys, RunSummary, UavSummary, map_series_csv, uav_series_csv, write_atomically,
+    ExplorationKeys, RunSummary, UavSummary, map_series_csv, stage_timings_csv, uav_series_csv,
+    write_atomically,
 };
 use crate::reachable::ReachableVolume;
 use crate::record;
@@ -24,6 +25,7 @@ use uavex_components::uav::{PredictedMission, Uav, UavEnded};
 use uavex_components::world::WorldGeometry;
 use uavex_systems::flight::{EnergySummary, FlightEnergy};
 use uavex_systems::mapping::{MapReader, OccupancyMap, map_accuracy};
+use uavex_systems::stage_clock::StageClock;
 
 /// How to run a scenario.
 #[derive(Debug, Clone, Default)]
@@ -296,6 +298,12 @@ fn write_outputs(
         write_atomically(
             &dir.join("decision_timings.csv"),
             decision_timings_csv(timings).as_bytes(),
+        )?;
+    }
+    if let Some(clock) = world.get_resource::<StageClock>() {
+        write_atomically(
+            &dir.join("stage_timings.csv"),
+            stage_timings_csv(clock).as_bytes(),
         )?;
     }
     // The summary goes last: its presence marks a run whose files are all written.

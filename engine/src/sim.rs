@@ -22,6 +22,7 @@ use uavex_systems::behaviour::waypoints::finish_waypoint_tours;
 use uavex_systems::flight::track_references;
 use uavex_systems::mapping::{insert_map_resources, integrate_scans};
 use uavex_systems::sensing::sense;
+use uavex_systems::stage_clock::{StageClock, time_stages};
 use uavex_systems::stages::{Stage, tick_schedule};
 
 /// How often (ticks) [`Sim::run_within`] looks at the wall clock: 3.4 s simulated at 300 Hz,
@@ -232,6 +233,8 @@ impl Sim {
         }
 
         let mut schedule = tick_schedule();
+        world.insert_resource(StageClock::default());
+        time_stages(&mut schedule);
         schedule.add_systems((
             sense.in_set(Stage::Sense),
             integrate_scans.in_set(Stage::Map),

@@ -9,5 +9,6 @@ pub mod frontier;
 pub mod mapping;
 pub mod planning;
 pub mod sensing;
+pub mod stage_clock;
 pub mod stages;
 pub mod trajectory;

@@ -45,6 +45,11 @@ impl Stage {
         Stage::Physics,
         Stage::Account,
     ];
+
+    /// This stage's place in [`Stage::ORDER`].
+    pub const fn index(self) -> usize {
+        self as usize
+    }
 }
 
 /// A schedule with the stages chained in tick order and no systems yet.
@@ -65,4 +70,16 @@ pub fn tick_schedule() -> Schedule {
             .chain(),
     );
     schedule
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_stage_index_is_its_place_in_the_order() {
+        for (i, stage) in Stage::ORDER.into_iter().enumerate() {
+            assert_eq!(stage.index(), i, "{stage:?}");
+        }
+    }
 }

@@ -4,7 +4,9 @@
 //! [`time_stages`] puts one small marker system between every two consecutive stages (and one
 //! before the first): each reads the clock once and charges the time since the previous marker
 //! to the stage that just ran. A stage's systems, its command flushes and any system a user
-//! adds to it are timed with it; nothing is charged for the time between ticks.
+//! adds to it are timed with it; nothing is charged for the time between ticks. A stage with no
+//! systems shows the markers' own cost (about 40 ns per tick on the project's machine; the ten
+//! of them add about 1 % to a Pillars mission).
 //!
 //! The figures measure the host, not the run: like the decision timings they differ from one
 //! machine (and one moment) to the next, and nothing in a run reads them back.

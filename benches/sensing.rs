@@ -275,6 +275,9 @@ impl Flight {
             report.voxel_visits += r.voxel_visits;
             report.skipped_voxels += r.skipped_voxels;
             report.chunk_visits += r.chunk_visits;
+            report.free_box_voxels += r.free_box_voxels;
+            report.free_box_rays += r.free_box_rays;
+            report.free_box_exits += r.free_box_exits;
             for (total, crossed) in report.cubes_crossed.iter_mut().zip(r.cubes_crossed) {
                 *total += crossed;
             }
@@ -290,10 +293,14 @@ fn flight(c: &mut Criterion) {
     flight.fly(&mut report);
     eprintln!(
         "flight: {} frames, {:.0} voxel visits per frame, {:.1} % passed over in saturated cubes \
-         (per frame: {:.0} bricks, {:.0} blocks, {:.0} chunks crossed; {:.0} chunk visits)",
+         (per frame: a free box of {:.0} voxels, {:.0} rays ending in it and {:.0} leaving it \
+         in one move; {:.0} bricks, {:.0} blocks, {:.0} chunks crossed; {:.0} chunk visits)",
         frames,
         report.voxel_visits as f64 / frames as f64,
         100.0 * report.skipped_voxels as f64 / report.voxel_visits as f64,
+        report.free_box_voxels as f64 / frames as f64,
+        report.free_box_rays as f64 / frames as f64,
+        report.free_box_exits as f64 / frames as f64,
         report.cubes_crossed[0] as f64 / frames as f64,
         report.cubes_crossed[1] as f64 / frames as f64,
         report.cubes_crossed[2] as f64 / frames as f64,

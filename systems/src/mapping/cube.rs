@@ -93,20 +93,36 @@ pub fn cross_cube<const EDGE: i64>(
     t: [i64; 3],
     dt: [i64; 3],
 ) -> CubeCrossing {
+    let ahead = [0, 1, 2].map(|a| ahead::<EDGE>(local[a], steps[a]));
+    cross_faces(ahead, t, dt, taken::<EDGE>)
+}
+
+/// The walk's move out of a box whose faces lie `ahead[a]` crossings away on each axis (at
+/// least 1; any value for an axis that does not move), as [`cross_cube`] describes it;
+/// `taken(t, dt, before)` counts an axis' crossings strictly before `before`, knowing there
+/// are fewer than its `ahead`. Shared by the cubes and the free box of a scan
+/// (`super::free_box`).
+#[inline(always)]
+pub(super) fn cross_faces(
+    ahead: [i64; 3],
+    t: [i64; 3],
+    dt: [i64; 3],
+    taken: impl Fn(i64, i64, i64) -> i64,
+) -> CubeCrossing {
     let [tx, ty, tz] = t;
     let [dtx, dty, dtz] = dt;
     let [cx, cy, cz] = dt.map(|dt| dt.min(DT_COMPARE_CAP));
-    let fx = tx + (ahead::<EDGE>(local[0], steps[0]) - 1) * cx;
-    let fy = ty + (ahead::<EDGE>(local[1], steps[1]) - 1) * cy;
-    let fz = tz + (ahead::<EDGE>(local[2], steps[2]) - 1) * cz;
+    let fx = tx + (ahead[0] - 1) * cx;
+    let fy = ty + (ahead[1] - 1) * cy;
+    let fz = tz + (ahead[2] - 1) * cz;
     let x = mask((fx <= fy) & (fx <= fz));
     let y = !x & mask(fy <= fz);
     let z = !x & !y;
     let face = (x & fx) | (y & fy) | (z & fz);
     // x wins ties against y and z, y against z: at `face`, those go first.
-    let kx = taken::<EDGE>(tx, cx, face + (1 & !x)) + (1 & x);
-    let ky = taken::<EDGE>(ty, cy, face + (1 & z)) + (1 & y);
-    let kz = taken::<EDGE>(tz, cz, face) + (1 & z);
+    let kx = taken(tx, cx, face + (1 & !x)) + (1 & x);
+    let ky = taken(ty, cy, face + (1 & z)) + (1 & y);
+    let kz = taken(tz, cz, face) + (1 & z);
     CubeCrossing {
         crossings: [kx, ky, kz],
         // Exact for an accepted crossing (an axis slower than the cap then takes at most one);
@@ -210,7 +226,7 @@ pub fn cross_saturated(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
@@ -235,10 +251,25 @@ mod tests {
     /// intervals), until it enters another cube of edge `edge`.
     fn step_by_voxel(
         edge: i64,
-        mut local: [i64; 3],
+        local: [i64; 3],
         steps: [i64; 3],
         t: [i64; 3],
         dt: [i64; 3],
+    ) -> CubeCrossing {
+        let cube = local.map(|l| l.div_euclid(edge));
+        step_by_voxel_until(local, steps, t, dt, |k| {
+            k.map(|l| l.div_euclid(edge)) != cube
+        })
+    }
+
+    /// The voxel walk's own rule from `key`, one crossing at a time, until it enters a key
+    /// for which `left` holds.
+    pub(in crate::mapping) fn step_by_voxel_until(
+        mut key: [i64; 3],
+        steps: [i64; 3],
+        t: [i64; 3],
+        dt: [i64; 3],
+        left: impl Fn([i64; 3]) -> bool,
     ) -> CubeCrossing {
         let mut crossings = [0; 3];
         let dt = dt.map(i128::from);
@@ -246,11 +277,10 @@ mod tests {
         loop {
             let a = first(t);
             let face_time = t[a];
-            let cube_before = local[a].div_euclid(edge);
             crossings[a] += 1;
             t[a] += dt[a];
-            local[a] += steps[a];
-            if local[a].div_euclid(edge) != cube_before {
+            key[a] += steps[a];
+            if left(key) {
                 let fixed = |t: i128| i64::try_from(t).unwrap_or(MAX);
                 return CubeCrossing {
                     crossings,

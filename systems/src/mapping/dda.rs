@@ -220,14 +220,17 @@ impl VoxelWalk {
 
     /// Continues the walk at `key` with next boundary times `t_max`, after a caller's own loop
     /// (see `integrate`) took steps along the walk's axes without bookkeeping of their counts.
+    #[inline]
     pub fn resume(&mut self, key: IVec3, t_max: [i64; 3]) {
         for axis in 0..3 {
             let taken = (key[axis] - self.key[axis]).unsigned_abs();
             self.remaining[axis] = self.remaining[axis].saturating_sub(taken);
-            self.t_max[axis] = if self.remaining[axis] == 0 {
-                T_RETIRED
+            // A retired axis moves no more: its interval goes too, so that arithmetic on the
+            // boundary times (`super::cube`) never adds an interval to `T_RETIRED`.
+            (self.t_max[axis], self.t_delta[axis]) = if self.remaining[axis] == 0 {
+                (T_RETIRED, 0)
             } else {
-                t_max[axis]
+                (t_max[axis], self.t_delta[axis])
             };
             self.key[axis] = key[axis];
         }

@@ -16,12 +16,13 @@
 
 use super::cube::{Cube, CubeLimit, cross_cube, cross_saturated};
 use super::dda::{SegmentClipper, T_ONE, VoxelWalk, to_fixed};
+use super::free_box::FreeBox;
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
 use std::cell::RefCell;
 use uavex_components::map::{
-    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
-    StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
+    BRICK_EDGE, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig,
+    ScanId, StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
 };
 use uavex_components::sensor::Scan;
 
@@ -42,6 +43,12 @@ pub trait ChunkAccess {
 
     /// Told once per visit of a chunk in which some voxel's log-odds changed.
     fn mark_written(&mut self, flat: usize);
+
+    /// The full bricks of the chunk with flat index `flat` ([`BrickSaturation::full_bricks`];
+    /// none for a chunk not created yet, all of whose voxels are unknown).
+    ///
+    /// [`BrickSaturation::full_bricks`]: uavex_components::map::BrickSaturation::full_bricks
+    fn full_bricks(&self, flat: usize) -> u64;
 }
 
 /// The rays of one scan, in the world frame (see [`Scan`]).
@@ -84,6 +91,12 @@ pub struct ScanReport {
     pub cubes_crossed: [u64; 3],
     /// Chunks the walks entered or crossed (one per chunk per ray).
     pub chunk_visits: u64,
+    /// Voxels in the scan's free box (`super::free_box`; 0 when it had none).
+    pub free_box_voxels: u64,
+    /// Rays that ended inside the free box (skipped whole).
+    pub free_box_rays: u64,
+    /// Rays that left the free box in one move.
+    pub free_box_exits: u64,
 }
 
 /// A scan that cannot be integrated (refused before anything is written).
@@ -146,8 +159,15 @@ pub fn integrate_scan(
             }
         }
 
-        // Pass 2: free space along every ray, skipping voxels this scan already updated.
+        // Pass 2: free space along every ray, skipping voxels this scan already updated. The
+        // free box is grown after the hits (which may unsaturate a voxel) and stays valid:
+        // misses only saturate more.
         let miss_rule = rule(increments.miss);
+        let free_box = if miss_rule.delta <= 0 {
+            run.free_box(config, origin, ends)
+        } else {
+            None
+        };
         let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
         for (&end, &hit) in ends.iter().zip(rays.hit) {
             let Some(clip) = clipper.clip(end) else {
@@ -156,7 +176,19 @@ pub fn integrate_scan(
             let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
             let exclude_end = hit && clip.end_inside;
             let visits = walk.steps_left() + 1 - u64::from(exclude_end);
-            run.update_walk(walk, clip.t_end, visits, miss_rule);
+            run.report.voxel_visits += visits;
+            let t_safe = clip.t_end - end_margin(&walk);
+            let mut walk = walk;
+            let visits = match &free_box {
+                Some(free) => {
+                    match run.leave_free_box(free, &mut walk, clip.end_key, t_safe, visits) {
+                        Some(left) => left,
+                        None => continue,
+                    }
+                }
+                None => visits,
+            };
+            run.update_walk(walk, t_safe, visits, miss_rule);
         }
     });
     Ok(run.report)
@@ -225,19 +257,87 @@ impl<C: ChunkAccess> Integration<'_, C> {
         }
     }
 
-    /// Updates the first `visits` voxels of `walk` (all inside the map), whose segment ends at
-    /// parameter `t_end`.
+    /// The scan's free box ([`FreeBox::grow`]) around the sensor at `origin` (voxel units),
+    /// within the key box of the rays' ends `ends`; none when the sensor is outside the map.
+    fn free_box(&mut self, config: &MapConfig, origin: DVec3, ends: &[DVec3]) -> Option<FreeBox> {
+        let origin_key = floor_to_key(origin);
+        if !config.contains_key(origin_key) {
+            return None;
+        }
+        let (lo, hi) = ends
+            .iter()
+            .fold((origin_key, origin_key), |(lo, hi), &end| {
+                let key = floor_to_key(end);
+                (lo.min(key), hi.max(key))
+            });
+        let (lo, hi) = (lo.max(config.key_min()), hi.min(config.key_max()));
+        let (grid, chunks) = (self.grid, &*self.chunks);
+        let free = FreeBox::grow(origin_key, lo, hi, |brick| {
+            let Some(flat) = grid.flat(ChunkCoord::of_key(brick * BRICK_EDGE)) else {
+                return false;
+            };
+            let local = brick & (CHUNK_EDGE / BRICK_EDGE - 1);
+            let bit = local.x + 4 * local.y + 16 * local.z;
+            chunks.full_bricks(flat) >> bit & 1 == 1
+        });
+        self.report.free_box_voxels =
+            free.map_or(0, |b| (b.hi - b.lo + IVec3::ONE).element_product() as u64);
+        free
+    }
+
+    /// Moves `walk` (with `visits` voxels to visit, its segment safe until `t_safe`) out of
+    /// the scan's free box in one move: the visits left, or `None` when the walk ends inside
+    /// the box (all its visits would change nothing). A walk that does not start in the box,
+    /// or leaves it only within the end margin, stays where it is.
+    #[inline]
+    fn leave_free_box(
+        &mut self,
+        free: &FreeBox,
+        walk: &mut VoxelWalk,
+        end_key: IVec3,
+        t_safe: f64,
+        visits: u64,
+    ) -> Option<u64> {
+        let key = walk.key();
+        if !free.contains(key) {
+            return Some(visits);
+        }
+        if free.contains(end_key) {
+            self.report.skipped_voxels += visits;
+            self.report.free_box_rays += 1;
+            return None;
+        }
+        let crossing = free.cross(
+            key,
+            walk.steps().map(i64::from),
+            walk.boundary_times(),
+            walk.boundary_intervals(),
+        );
+        if crossing.face_time >= to_fixed(t_safe) {
+            return Some(visits);
+        }
+        // Every crossing is before `t_safe`: the voxels passed are on the walk, and the one
+        // entered is too (unless it is a hit's excluded end voxel: then no visit is left).
+        let passed = crossing.voxels_passed() as u64;
+        debug_assert!(passed <= visits);
+        self.report.skipped_voxels += passed;
+        self.report.free_box_exits += 1;
+        let [kx, ky, kz] = crossing.crossings;
+        let [mx, my, mz] = walk.steps();
+        let moved = IVec3::new(kx as i32 * mx, ky as i32 * my, kz as i32 * mz);
+        walk.resume(key + moved, crossing.boundary_times);
+        Some(visits - passed)
+    }
+
+    /// Updates the first `visits` voxels of `walk` (all inside the map), whose segment is safe
+    /// until parameter `t_safe` ([`end_margin`]).
     ///
     /// Most steps run in [`Self::walk_fast`]; the last steps, whose boundaries lie within a
     /// margin of the end (where rounding could order a boundary beyond the end key before a
-    /// real one), take the counted walk of [`VoxelWalk::advance`], voxel by voxel. The margin
-    /// is [`END_MARGIN`] plus twice the worst accumulated truncation of the fixed-point
-    /// boundary times ([`T_ONE`]): 2^-44 per step, below 6e-8 after 2^20 steps.
-    fn update_walk(&mut self, mut walk: VoxelWalk, t_end: f64, visits: u64, rule: UpdateRule) {
-        self.report.voxel_visits += visits;
-        let margin = END_MARGIN + 2.0 * (walk.steps_left() + 1) as f64 / T_ONE;
+    /// real one), take the counted walk of [`VoxelWalk::advance`], voxel by voxel.
+    fn update_walk(&mut self, mut walk: VoxelWalk, t_safe: f64, visits: u64, rule: UpdateRule) {
         // `walk` stays at the last voxel updated.
-        let mut visits = self.walk_fast(&mut walk, t_end - margin, visits, rule);
+        let mut visits = self.walk_fast(&mut walk, t_safe, visits, rule);
         while visits > 0 {
             walk.advance();
             self.update_one(walk.key(), rule);
@@ -409,6 +509,14 @@ impl<C: ChunkAccess> Integration<'_, C> {
 #[inline(always)]
 fn mask(c: bool) -> i64 {
     -i64::from(c)
+}
+
+/// The margin before the end of `walk`'s segment (segment parameter) within which its
+/// boundaries are left to the counted walk: [`END_MARGIN`] plus twice the worst accumulated
+/// truncation of the fixed-point boundary times ([`T_ONE`]): 2^-44 per step, below 6e-8
+/// after 2^20 steps.
+fn end_margin(walk: &VoxelWalk) -> f64 {
+    END_MARGIN + 2.0 * (walk.steps_left() + 1) as f64 / T_ONE
 }
 
 /// Base margin (segment parameter) before the end of a segment within which boundaries are

@@ -4,6 +4,8 @@
 //! - [`dda`]: Amanatides & Woo voxel traversal, clipped to the map.
 //! - [`update`]: the log-odds update of one voxel (stamp, add, clamp, statistics).
 //! - [`cube`]: walking past a cube (brick, block, chunk) of saturated free voxels in one move.
+//! - [`free_box`]: the box of saturated free bricks around a scan's sensor, which every ray
+//!   leaves in one move.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
 //! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
@@ -17,6 +19,7 @@
 
 pub mod cube;
 pub mod dda;
+pub mod free_box;
 pub mod integrate;
 pub mod read;
 pub mod state_changes;

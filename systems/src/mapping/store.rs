@@ -65,6 +65,12 @@ impl ChunkAccess for ChunkStore {
         (chunk, stats)
     }
 
+    fn full_bricks(&self, flat: usize) -> u64 {
+        self.chunks[flat]
+            .as_ref()
+            .map_or(0, |(chunk, _)| chunk.saturation().full_bricks())
+    }
+
     #[inline]
     fn mark_written(&mut self, flat: usize) {
         if !self.written_flags[flat] {

@@ -244,6 +244,18 @@ impl ChunkAccess for EcsChunks<'_, '_> {
         )
     }
 
+    fn full_bricks(&self, flat: usize) -> u64 {
+        let slot = self.slot_of[flat];
+        let chunk = if slot == NO_SLOT {
+            return 0;
+        } else if slot & CREATED != 0 {
+            &self.created[(slot & !CREATED) as usize].chunk
+        } else {
+            &*self.existing[slot as usize].chunk
+        };
+        chunk.saturation().full_bricks()
+    }
+
     fn mark_written(&mut self, flat: usize) {
         let slot = self.slot_of[flat];
         if slot & CREATED == 0

@@ -469,6 +469,7 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         miss: -847,
     };
     let (mut visits, mut skipped, mut cubes) = (0, 0, [0; 3]);
+    let (mut box_rays, mut box_exits) = (0, 0);
     for scan in 0..310 {
         let rays: Vec<(Vec3, bool)>;
         let origin;
@@ -504,6 +505,8 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         let report = m.scan_with(origin, &rays, inc);
         visits += report.voxel_visits;
         skipped += report.skipped_voxels;
+        box_rays += report.free_box_rays;
+        box_exits += report.free_box_exits;
         for (total, crossed) in cubes.iter_mut().zip(report.cubes_crossed) {
             *total += crossed;
         }
@@ -558,6 +561,12 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
     );
     // Every size of cube was crossed: bricks, blocks and whole chunks.
     assert!(cubes.iter().all(|&n| n > 0), "cubes crossed {cubes:?}");
+    // And scans from inside the saturated chunk had a free box: rays ended in it, others left
+    // it in one move.
+    assert!(
+        box_rays > 0 && box_exits > 0,
+        "free box: {box_rays} rays ended in it, {box_exits} left it"
+    );
 }
 
 /// Direction `i` of `n` spread evenly over the sphere (a Fibonacci lattice).

@@ -1,0 +1,219 @@
+//! The free box of a scan: a box of saturated free bricks around the sensor, grown once per
+//! scan, that every ray of the scan leaves in one move.
+//!
+//! Why: near itself a camera in flight sees space it saw a few frames before, saturated free,
+//! where a miss changes nothing (common.md §1: clamping). The walks cross such space cube by
+//! cube (`super::cube`: a brick, block or chunk per move, and a chunk visit at every chunk
+//! boundary), the same space again for each of a scan's ~2,000 rays. All of them start in the
+//! sensor's voxel, so one box around it serves them all:
+//! - a walk from a key in the box to a key in the box stays in it (a box is convex, and each
+//!   axis of a walk moves one way), so a ray that ends inside changes nothing and is skipped;
+//! - any other ray leaves the box in one move with exactly the crossings and boundary times
+//!   that stepping voxel by voxel would reach ([`FreeBox::cross`], the cubes' own rule), and
+//!   walks on from there as before.
+//!
+//! The map that results is the same bit for bit. The box is grown greedily, one brick layer
+//! per face in turn (+x, -x, +y, -y, +z, -z), while the new layer's bricks are all full: not
+//! the largest box there is, but deterministic and cheap (a bit test per brick).
+
+use super::cube::{CubeCrossing, cross_faces};
+use glam::IVec3;
+use uavex_components::map::BRICK_EDGE;
+
+/// A box of voxel keys (`lo..=hi`, aligned to bricks) whose voxels inside the map are all
+/// saturated free.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FreeBox {
+    pub lo: IVec3,
+    pub hi: IVec3,
+}
+
+/// log2 of [`BRICK_EDGE`].
+const BRICK_SHIFT: i32 = BRICK_EDGE.trailing_zeros() as i32;
+
+impl FreeBox {
+    /// The box grown from the brick of `origin` (a key) within the bricks that meet the key box
+    /// `limit_lo..=limit_hi`, where `full(brick)` tells whether a brick (by brick coordinates,
+    /// key / 4) is full of saturated free voxels. `None` when the origin's brick is not.
+    pub fn grow(
+        origin: IVec3,
+        limit_lo: IVec3,
+        limit_hi: IVec3,
+        mut full: impl FnMut(IVec3) -> bool,
+    ) -> Option<Self> {
+        let (limit_lo, limit_hi) = (limit_lo >> BRICK_SHIFT, limit_hi >> BRICK_SHIFT);
+        let start = origin >> BRICK_SHIFT;
+        if !full(start) {
+            return None;
+        }
+        let (mut lo, mut hi) = (start, start);
+        let mut open = [true; 6];
+        while open.contains(&true) {
+            for (face, open) in open.iter_mut().enumerate() {
+                if !*open {
+                    continue;
+                }
+                let axis = face / 2;
+                let up = face % 2 == 0;
+                let layer = if up { hi[axis] + 1 } else { lo[axis] - 1 };
+                let (mut from, mut to) = (lo, hi);
+                (from[axis], to[axis]) = (layer, layer);
+                let inside = if up {
+                    layer <= limit_hi[axis]
+                } else {
+                    layer >= limit_lo[axis]
+                };
+                if inside && all_bricks(from, to, &mut full) {
+                    if up {
+                        hi[axis] = layer;
+                    } else {
+                        lo[axis] = layer;
+                    }
+                } else {
+                    *open = false;
+                }
+            }
+        }
+        Some(Self {
+            lo: lo << BRICK_SHIFT,
+            hi: (hi << BRICK_SHIFT) + IVec3::splat(BRICK_EDGE - 1),
+        })
+    }
+
+    #[inline]
+    pub fn contains(&self, key: IVec3) -> bool {
+        key.cmpge(self.lo).all() && key.cmple(self.hi).all()
+    }
+
+    /// The walk's move out of the box from `key` (inside it), with steps (+1, -1 or 0 per
+    /// axis), next boundary times `t` and intervals `dt` in the walk's fixed point (an axis
+    /// that does not move has time `i64::MAX` and interval 0): the crossings of each axis up
+    /// to the face it leaves through, as [`super::cube::cross_cube`] defines them for a cube.
+    /// The caller accepts it only if the face comes before the end of its segment.
+    #[inline]
+    pub fn cross(&self, key: IVec3, steps: [i64; 3], t: [i64; 3], dt: [i64; 3]) -> CubeCrossing {
+        let ahead = [0, 1, 2].map(|a| match steps[a] {
+            1 => i64::from(self.hi[a] - key[a]) + 1,
+            -1 => i64::from(key[a] - self.lo[a]) + 1,
+            _ => 1,
+        });
+        cross_faces(ahead, t, dt, |t, dt, before| {
+            // The j >= 0 with t + j dt < before: ceil((before - t) / dt) of them. An axis that
+            // does not move (dt = 0) has t = i64::MAX, past any `before`.
+            if before > t {
+                (before - t - 1) / dt.max(1) + 1
+            } else {
+                0
+            }
+        })
+    }
+}
+
+/// Whether every brick of `from..=to` is full.
+fn all_bricks(from: IVec3, to: IVec3, full: &mut impl FnMut(IVec3) -> bool) -> bool {
+    (from.z..=to.z)
+        .all(|z| (from.y..=to.y).all(|y| (from.x..=to.x).all(|x| full(IVec3::new(x, y, z)))))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mapping::cube::tests::step_by_voxel_until;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    #[test]
+    fn grows_until_a_brick_that_is_not_full_on_every_side() {
+        // Full bricks: x in -3..=5, y in -2..=1, z in 0..=0 except brick (2, 1, 0).
+        let full = |b: IVec3| {
+            (-3..=5).contains(&b.x)
+                && (-2..=1).contains(&b.y)
+                && b.z == 0
+                && b != IVec3::new(2, 1, 0)
+        };
+        let free = FreeBox::grow(
+            IVec3::new(1, 2, 3),
+            IVec3::splat(-100),
+            IVec3::splat(100),
+            full,
+        )
+        .expect("the origin's brick is full");
+        // By hand, face by face (+x, -x, +y, -y; z never grows): round 1 takes x = 1, x = -1,
+        // y = 1, y = -1; round 2 finds brick (2, 1, 0) in the +x layer (closed), takes x = -2,
+        // finds no y = 2 (closed), takes y = -2; round 3 takes x = -3 and closes -y; round 4
+        // closes -x. Bricks (-3, -2, 0) to (1, 1, 0).
+        assert_eq!(free.lo, IVec3::new(-12, -8, 0));
+        assert_eq!(free.hi, IVec3::new(7, 7, 3));
+        for x in free.lo.x >> 2..=free.hi.x >> 2 {
+            for y in free.lo.y >> 2..=free.hi.y >> 2 {
+                assert!(full(IVec3::new(x, y, 0)));
+            }
+        }
+    }
+
+    #[test]
+    fn no_box_when_the_origin_brick_is_not_full_and_none_beyond_the_limits() {
+        assert_eq!(
+            FreeBox::grow(IVec3::ZERO, IVec3::splat(-9), IVec3::splat(9), |_| false),
+            None
+        );
+        let free = FreeBox::grow(IVec3::ZERO, IVec3::splat(-5), IVec3::splat(9), |_| true)
+            .expect("all full");
+        // Keys -5..=9 meet bricks -2..=2.
+        assert_eq!((free.lo, free.hi), (IVec3::splat(-8), IVec3::splat(11)));
+    }
+
+    /// Leaving a random box from a random key inside it in one move equals stepping voxel by
+    /// voxel until the walk first stands outside it (ties included).
+    #[test]
+    fn one_move_out_of_the_box_equals_stepping_voxel_by_voxel() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for case in 0..20_000 {
+            let lo = IVec3::new(
+                rng.random_range(-40..0),
+                rng.random_range(-40..0),
+                rng.random_range(-40..0),
+            );
+            let hi = lo
+                + IVec3::new(
+                    rng.random_range(0..60),
+                    rng.random_range(0..60),
+                    rng.random_range(0..60),
+                );
+            let free = FreeBox { lo, hi };
+            let key = IVec3::new(
+                rng.random_range(lo.x..=hi.x),
+                rng.random_range(lo.y..=hi.y),
+                rng.random_range(lo.z..=hi.z),
+            );
+            let mut steps = [0i64; 3];
+            let mut t = [i64::MAX; 3];
+            let mut dt = [0i64; 3];
+            for a in 0..3 {
+                // Some axes still, some intervals shared (ties), the rest random.
+                match rng.random_range(0..6) {
+                    0 => continue,
+                    1 => dt[a] = 1 << 40,
+                    _ => dt[a] = rng.random_range(1i64 << 36..1 << 46),
+                }
+                steps[a] = if rng.random() { 1 } else { -1 };
+                t[a] = if dt[a] == 1 << 40 {
+                    1 << 39
+                } else {
+                    rng.random_range(0..dt[a])
+                };
+            }
+            if steps == [0; 3] {
+                continue;
+            }
+            let moved = free.cross(key, steps, t, dt);
+            let stepped = step_by_voxel_until(key.as_i64vec3().to_array(), steps, t, dt, |k| {
+                !free.contains(IVec3::new(k[0] as i32, k[1] as i32, k[2] as i32))
+            });
+            assert_eq!(
+                moved, stepped,
+                "case {case}: {free:?} from {key}, {steps:?} {t:?} {dt:?}"
+            );
+        }
+    }
+}

@@ -264,13 +264,12 @@ impl<C: ChunkAccess> Integration<'_, C> {
         if !config.contains_key(origin_key) {
             return None;
         }
-        let (lo, hi) = ends
-            .iter()
-            .fold((origin_key, origin_key), |(lo, hi), &end| {
-                let key = floor_to_key(end);
-                (lo.min(key), hi.max(key))
-            });
-        let (lo, hi) = (lo.max(config.key_min()), hi.min(config.key_max()));
+        // The keys' box from the points' box: `floor` is monotonic.
+        let (lo, hi) = ends.iter().fold((origin, origin), |(lo, hi), &end| {
+            (lo.min(end), hi.max(end))
+        });
+        let lo = floor_to_key(lo).max(config.key_min());
+        let hi = floor_to_key(hi).min(config.key_max());
         let (grid, chunks) = (self.grid, &*self.chunks);
         let free = FreeBox::grow(origin_key, lo, hi, |brick| {
             let Some(flat) = grid.flat(ChunkCoord::of_key(brick * BRICK_EDGE)) else {

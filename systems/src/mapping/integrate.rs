@@ -16,7 +16,7 @@
 
 use super::cube::{Cube, CubeLimit, cross_cube, cross_saturated};
 use super::dda::{SegmentClipper, T_ONE, VoxelWalk, to_fixed};
-use super::free_box::FreeBox;
+use super::free_box::{FreeBox, FreeBoxes};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
 use std::cell::RefCell;
@@ -91,11 +91,11 @@ pub struct ScanReport {
     pub cubes_crossed: [u64; 3],
     /// Chunks the walks entered or crossed (one per chunk per ray).
     pub chunk_visits: u64,
-    /// Voxels in the scan's free box (`super::free_box`; 0 when it had none).
+    /// Voxels in the scan's first free box (`super::free_box`; 0 when it had none).
     pub free_box_voxels: u64,
-    /// Rays that ended inside the free box (skipped whole).
+    /// Rays that ended inside a free box (skipped whole).
     pub free_box_rays: u64,
-    /// Rays that left the free box in one move.
+    /// Moves out of a free box (a ray may leave more than one).
     pub free_box_exits: u64,
 }
 
@@ -160,13 +160,13 @@ pub fn integrate_scan(
         }
 
         // Pass 2: free space along every ray, skipping voxels this scan already updated. The
-        // free box is grown after the hits (which may unsaturate a voxel) and stays valid:
+        // free boxes are grown after the hits (which may unsaturate a voxel) and stay valid:
         // misses only saturate more.
         let miss_rule = rule(increments.miss);
-        let free_box = if miss_rule.delta <= 0 {
-            run.free_box(config, origin, ends)
+        let free_boxes = if miss_rule.delta <= 0 {
+            run.free_boxes(config, origin, ends)
         } else {
-            None
+            FreeBoxes::default()
         };
         let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
         for (&end, &hit) in ends.iter().zip(rays.hit) {
@@ -179,14 +179,10 @@ pub fn integrate_scan(
             run.report.voxel_visits += visits;
             let t_safe = clip.t_end - end_margin(&walk);
             let mut walk = walk;
-            let visits = match &free_box {
-                Some(free) => {
-                    match run.leave_free_box(free, &mut walk, clip.end_key, t_safe, visits) {
-                        Some(left) => left,
-                        None => continue,
-                    }
-                }
-                None => visits,
+            let Some(visits) =
+                run.leave_free_boxes(&free_boxes, &mut walk, clip.end_key, t_safe, visits)
+            else {
+                continue;
             };
             run.update_walk(walk, t_safe, visits, miss_rule);
         }
@@ -257,12 +253,13 @@ impl<C: ChunkAccess> Integration<'_, C> {
         }
     }
 
-    /// The scan's free box ([`FreeBox::grow`]) around the sensor at `origin` (voxel units),
-    /// within the key box of the rays' ends `ends`; none when the sensor is outside the map.
-    fn free_box(&mut self, config: &MapConfig, origin: DVec3, ends: &[DVec3]) -> Option<FreeBox> {
+    /// The scan's free boxes ([`FreeBoxes::grow`]) around the sensor at `origin` (voxel
+    /// units), within the key box of the rays' ends `ends`; none when the sensor is outside the
+    /// map.
+    fn free_boxes(&mut self, config: &MapConfig, origin: DVec3, ends: &[DVec3]) -> FreeBoxes {
         let origin_key = floor_to_key(origin);
         if !config.contains_key(origin_key) {
-            return None;
+            return FreeBoxes::default();
         }
         // The keys' box from the points' box: `floor` is monotonic.
         let (lo, hi) = ends.iter().fold((origin, origin), |(lo, hi), &end| {
@@ -271,7 +268,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let lo = floor_to_key(lo).max(config.key_min());
         let hi = floor_to_key(hi).min(config.key_max());
         let (grid, chunks) = (self.grid, &*self.chunks);
-        let free = FreeBox::grow(origin_key, lo, hi, |brick| {
+        let boxes = FreeBoxes::grow(origin_key, lo, hi, |brick| {
             let Some(flat) = grid.flat(ChunkCoord::of_key(brick * BRICK_EDGE)) else {
                 return false;
             };
@@ -279,9 +276,31 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let bit = local.x + 4 * local.y + 16 * local.z;
             chunks.full_bricks(flat) >> bit & 1 == 1
         });
-        self.report.free_box_voxels =
-            free.map_or(0, |b| (b.hi - b.lo + IVec3::ONE).element_product() as u64);
-        free
+        self.report.free_box_voxels = boxes
+            .iter()
+            .next()
+            .map_or(0, |b| (b.hi - b.lo + IVec3::ONE).element_product() as u64);
+        boxes
+    }
+
+    /// Moves `walk` out of each of the scan's free boxes it is in, in turn ([`Self::leave_free_box`]):
+    /// the visits left, or `None` when it ends inside one.
+    #[inline]
+    fn leave_free_boxes(
+        &mut self,
+        boxes: &FreeBoxes,
+        walk: &mut VoxelWalk,
+        end_key: IVec3,
+        t_safe: f64,
+        mut visits: u64,
+    ) -> Option<u64> {
+        for free in boxes.iter() {
+            if visits == 0 {
+                break;
+            }
+            visits = self.leave_free_box(free, walk, end_key, t_safe, visits)?;
+        }
+        Some(visits)
     }
 
     /// Moves `walk` (with `visits` voxels to visit, its segment safe until `t_safe`) out of

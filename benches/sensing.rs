@@ -293,8 +293,8 @@ fn flight(c: &mut Criterion) {
     flight.fly(&mut report);
     eprintln!(
         "flight: {} frames, {:.0} voxel visits per frame, {:.1} % passed over in saturated cubes \
-         (per frame: a first free box of {:.0} voxels, {:.0} rays ending in a box, {:.0} moves out of one \
-         in one move; {:.0} bricks, {:.0} blocks, {:.0} chunks crossed; {:.0} chunk visits)",
+         (per frame: a first free box of {:.0} voxels, {:.0} rays ending in a box, {:.0} moves \
+         out of one; {:.0} bricks, {:.0} blocks, {:.0} chunks crossed; {:.0} chunk visits)",
         frames,
         report.voxel_visits as f64 / frames as f64,
         100.0 * report.skipped_voxels as f64 / report.voxel_visits as f64,

@@ -283,8 +283,8 @@ impl<C: ChunkAccess> Integration<'_, C> {
         boxes
     }
 
-    /// Moves `walk` out of each of the scan's free boxes it is in, in turn ([`Self::leave_free_box`]):
-    /// the visits left, or `None` when it ends inside one.
+    /// Moves `walk` out of each of the scan's free boxes it is in, in turn
+    /// ([`Self::leave_free_box`]): the visits left, or `None` when it ends inside one.
     #[inline]
     fn leave_free_boxes(
         &mut self,

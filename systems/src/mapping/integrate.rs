@@ -173,12 +173,11 @@ pub fn integrate_scan(
             let Some(clip) = clipper.clip(end) else {
                 continue;
             };
-            let walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
+            let mut walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
             let exclude_end = hit && clip.end_inside;
             let visits = walk.steps_left() + 1 - u64::from(exclude_end);
             run.report.voxel_visits += visits;
             let t_safe = clip.t_end - end_margin(&walk);
-            let mut walk = walk;
             let Some(visits) =
                 run.leave_free_boxes(&free_boxes, &mut walk, clip.end_key, t_safe, visits)
             else {

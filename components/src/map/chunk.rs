@@ -175,13 +175,26 @@ impl Voxel {
 /// occupied). [`Self::state_version`] changes whenever some voxel's state may have changed (the
 /// map update bumps it when one did, a write through [`Self::voxels_mut`] always), so such
 /// consumers skip chunks that are `Changed` but whose states are not
-/// (`uavex_systems::mapping::StateVersions`).
+/// (`uavex_systems::mapping::StateChanges`). The chunk also remembers *where* the last scan
+/// that changed states here changed them ([`Self::state_changed_bricks_since`]), so that they
+/// re-examine only the neighbours those bricks can reach.
 #[derive(Component, Debug, Clone, PartialEq, Eq)]
 pub struct VoxelChunk {
     voxels: Box<[Voxel; CHUNK_VOXELS]>,
     epoch: u32,
     saturation: BrickSaturation,
     state_version: u32,
+    state_log: StateLog,
+}
+
+/// The bricks (bit `b` for brick `b`, as [`super::brick_of`] numbers them) in which the scan
+/// `scan` (a raw [`ScanId`], 0 for none) changed voxel states, and the state version before its
+/// first change here.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+struct StateLog {
+    scan: u64,
+    base: u32,
+    bricks: u64,
 }
 
 impl Default for VoxelChunk {
@@ -198,6 +211,7 @@ impl VoxelChunk {
             epoch: 0,
             saturation: BrickSaturation::NONE,
             state_version: 0,
+            state_log: StateLog::default(),
         }
     }
 
@@ -237,11 +251,42 @@ impl VoxelChunk {
         self.state_version
     }
 
-    /// Records that some voxel's state changed (the map update calls it after writing through
-    /// [`Self::voxels_and_saturation_mut`]).
+    /// Records that some voxel's state may have changed, anywhere in the chunk.
     #[inline]
     pub fn note_state_change(&mut self) {
+        self.note_state_changes_in(ScanId(0), u64::MAX);
+    }
+
+    /// Records that scan `scan` changed the states of voxels in `bricks` (a set of brick bits;
+    /// the map update calls it after writing through [`Self::voxels_and_saturation_mut`], once
+    /// per visit of the chunk).
+    #[inline]
+    pub fn note_state_changes_in(&mut self, scan: ScanId, bricks: u64) {
+        if bricks == 0 {
+            return;
+        }
+        if self.state_log.scan != scan.0 || scan.0 == 0 {
+            self.state_log = StateLog {
+                scan: scan.0,
+                base: self.state_version,
+                bricks: 0,
+            };
+        }
+        self.state_log.bricks |= bricks;
         self.state_version = self.state_version.wrapping_add(1);
+    }
+
+    /// The bricks in which voxel states may have changed since the chunk's state version was
+    /// `seen`: none if it still is; the last scan's bricks if `seen` is the version that scan
+    /// started from (a consumer that looks after every scan); otherwise, or for a consumer that
+    /// never saw the chunk (`None`), all of them.
+    #[inline]
+    pub fn state_changed_bricks_since(&self, seen: Option<u32>) -> u64 {
+        match seen {
+            Some(seen) if seen == self.state_version => 0,
+            Some(seen) if seen == self.state_log.base => self.state_log.bricks,
+            _ => u64::MAX,
+        }
     }
 
     /// Mutable voxels and the saturation of their bricks, for the map update, which keeps the
@@ -427,6 +472,36 @@ mod tests {
         chunk.voxels_mut()[0].log_odds = 100;
         assert!(!chunk.saturation().brick_full(3));
         assert_ne!(chunk.state_version(), version);
+    }
+
+    #[test]
+    fn the_state_log_keeps_the_last_scans_bricks_and_falls_back_to_all() {
+        let mut chunk = VoxelChunk::new();
+        let v0 = chunk.state_version();
+        assert_eq!(chunk.state_changed_bricks_since(Some(v0)), 0);
+        assert_eq!(chunk.state_changed_bricks_since(None), u64::MAX);
+        // One scan, two visits: their union, for a consumer that saw the version before it.
+        let scan = ScanId::after(None);
+        chunk.note_state_changes_in(scan, 1 << 3);
+        chunk.note_state_changes_in(scan, 1 << 40);
+        chunk.note_state_changes_in(scan, 0);
+        let v1 = chunk.state_version();
+        assert_eq!(chunk.state_changed_bricks_since(Some(v0)), 1 << 3 | 1 << 40);
+        assert_eq!(chunk.state_changed_bricks_since(Some(v1)), 0);
+        // The next scan starts a new log: a consumer that saw `v1` gets its bricks only, one
+        // that last looked at `v0` (it missed a scan) gets every brick.
+        let next = ScanId::after(Some(scan));
+        chunk.note_state_changes_in(next, 1 << 7);
+        assert_eq!(chunk.state_changed_bricks_since(Some(v1)), 1 << 7);
+        assert_eq!(chunk.state_changed_bricks_since(Some(v0)), u64::MAX);
+        // A change of unknown place (a write by hand) means every brick.
+        let v2 = chunk.state_version();
+        chunk.voxels_mut()[0].log_odds = 100;
+        assert_eq!(chunk.state_changed_bricks_since(Some(v2)), u64::MAX);
+        // A scan after it is precise again for a consumer that saw the write.
+        let v3 = chunk.state_version();
+        chunk.note_state_changes_in(ScanId::after(Some(next)), 1 << 9);
+        assert_eq!(chunk.state_changed_bricks_since(Some(v3)), 1 << 9);
     }
 
     #[test]

@@ -7,12 +7,14 @@
 //!
 //! A voxel's status depends on itself and its six neighbours only, so when a scan changes a
 //! chunk, the voxels whose status may change lie in that chunk and in the face layers of its six
-//! face-neighbour chunks. [`update_frontier_set`] re-examines exactly those chunks, whole, with
+//! face-neighbour chunks, of those only whose face a changed brick touches
+//! ([`StateChange::reaches`] within one voxel). [`update_frontier_set`] re-examines exactly
+//! those chunks, whole, with
 //! the row-parallel [`chunk_frontier`]: 16 voxels (one x-row) per machine word, the x neighbours
 //! by shifts and the y/z neighbours as adjacent rows, read from the chunk arrays (no per-key
 //! lookups).
 
-use super::super::mapping::OccupancyMap;
+use super::super::mapping::{OccupancyMap, StateChange};
 use glam::IVec3;
 use uavex_components::frontier::{FrontierSet, VoxelMask};
 use uavex_components::map::{CHUNK_EDGE, ChunkCoord, Voxel, VoxelChunk, VoxelState};
@@ -139,15 +141,25 @@ pub fn chunk_frontier(map: &impl OccupancyMap, coord: ChunkCoord) -> VoxelMask {
     out
 }
 
-/// Re-examines `changed` chunks AND their 6 face-neighbour chunks (a voxel turning known changes
-/// the frontier status of its neighbours across a chunk face) and writes their frontier voxels
-/// into `set`. Plain function, no ECS; the order of `changed` does not matter.
-pub fn update_frontier_set(set: &mut FrontierSet, map: &impl OccupancyMap, changed: &[ChunkCoord]) {
+/// Re-examines the `changed` chunks AND those of their 6 face-neighbour chunks whose face a
+/// changed brick touches (a voxel turning known changes the frontier status of its neighbours
+/// across a chunk face), and writes their frontier voxels into `set`. `changed` holds
+/// [`StateChange`]s, or chunk coordinates (a change anywhere in the chunk). Plain function, no
+/// ECS; the order of `changed` does not matter.
+pub fn update_frontier_set<C: Copy + Into<StateChange>>(
+    set: &mut FrontierSet,
+    map: &impl OccupancyMap,
+    changed: &[C],
+) {
     let grid = map.config().chunk_grid();
     let mut todo: Vec<usize> = Vec::with_capacity(changed.len() * 7);
-    for &coord in changed {
-        for d in [IVec3::ZERO].iter().chain(NEIGHBOURS.iter()) {
-            if let Some(flat) = grid.flat(ChunkCoord(coord.0 + *d)) {
+    for &change in changed {
+        let change: StateChange = change.into();
+        for &d in [IVec3::ZERO].iter().chain(NEIGHBOURS.iter()) {
+            if !change.reaches(d, 1) {
+                continue;
+            }
+            if let Some(flat) = grid.flat(ChunkCoord(change.coord.0 + d)) {
                 todo.push(flat);
             }
         }

@@ -1,6 +1,6 @@
 //! The thin ECS side of frontier detection and clustering.
 
-use super::super::mapping::{MapReader, StateChanges};
+use super::super::mapping::{MapReader, StateChange, StateChanges};
 use super::assemble::{ClusterData, cluster_frontier, match_clusters};
 use super::detect::update_frontier_set;
 use bevy_ecs::prelude::*;
@@ -9,7 +9,6 @@ use uavex_components::frontier::{
     ClusterMembers, ClusterSettings, ClusteringCounter, FrontierCluster, FrontierSet, Reachable,
     Viewpoints,
 };
-use uavex_components::map::ChunkCoord;
 use uavex_components::sim::{RunSeed, stream};
 
 /// Inserts [`FrontierSet`] (empty), `settings`, and the [`ClusteringCounter`]. The clustering
@@ -28,7 +27,7 @@ pub fn update_frontiers(
     mut changes: StateChanges,
     mut set: ResMut<FrontierSet>,
     map: MapReader,
-    mut scratch: Local<Vec<ChunkCoord>>,
+    mut scratch: Local<Vec<StateChange>>,
 ) {
     scratch.clear();
     changes.collect_into(&mut scratch);

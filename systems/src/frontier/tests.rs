@@ -2,14 +2,14 @@
 //! against the per-voxel definition.
 
 use super::*;
-use crate::mapping::{ChunkAccess, ChunkStore, OccupancyMap, ScanRays, integrate_scan};
+use crate::mapping::tests::{integrate_random_scan, integrate_rays};
+use crate::mapping::{ChunkAccess, ChunkStore, OccupancyMap};
 use glam::{DVec3, IVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use uavex_components::frontier::FrontierSet;
 use uavex_components::map::{
-    ChunkCoord, LogOddsIncrements, MapConfig, MapSettings, ScanCounter, StatSums, UNKNOWN_LOG_ODDS,
-    VoxelState,
+    ChunkCoord, MapConfig, MapSettings, ScanCounter, UNKNOWN_LOG_ODDS, VoxelState,
 };
 
 mod cluster_tests;
@@ -188,52 +188,69 @@ fn chunk_rows_agree_with_the_definition_on_random_grids() {
     assert_eq!(fs.len(), expected.len());
 }
 
+/// A scan that writes only one chunk still ends a frontier across that chunk's face: the
+/// neighbour whose face the changed brick touches is re-examined, though not written.
+#[test]
+fn a_scan_that_writes_one_chunk_updates_the_frontier_across_its_face() {
+    let mut store = ChunkStore::new(&config());
+    let mut counter = ScanCounter::default();
+    // Chunk 0 (keys 0..=15): voxel (15, 8, 8) and its neighbours in chunk 0 free, so that its
+    // one unknown neighbour is (16, 8, 8), in chunk 1.
+    // Chunk 1 exists already (a voxel far from its face is known), so that the scan below
+    // reports where in it states changed.
+    let edge = IVec3::new(15, 8, 8);
+    let known = [
+        edge,
+        edge - IVec3::X,
+        edge + IVec3::Y,
+        edge - IVec3::Y,
+        edge + IVec3::Z,
+    ];
+    for key in known
+        .into_iter()
+        .chain([edge - IVec3::Z, IVec3::new(28, 8, 8)])
+    {
+        let coord = set(&mut store, key, VoxelState::Free);
+        store.mark_written(store.config().chunk_grid().flat(coord).unwrap());
+    }
+    let mut incremental = FrontierSet::default();
+    let changes = store.take_state_changes();
+    assert_eq!(changes.len(), 2);
+    update_frontier_set(&mut incremental, &store, &changes);
+    assert!(incremental.contains(edge));
+    // A ray from inside chunk 1 hits (16, 8, 8): only chunk 1 is written.
+    let centre = |x: f32| Vec3::new(x, 0.85, 0.85);
+    integrate_rays(
+        &mut store,
+        &mut counter,
+        centre(2.45),
+        &[(centre(1.65), true)],
+    );
+    let changes = store.take_state_changes();
+    assert_eq!(changes.len(), 1);
+    assert_eq!(changes[0].coord, ChunkCoord(IVec3::new(1, 0, 0)));
+    assert_ne!(changes[0].bricks, u64::MAX);
+    update_frontier_set(&mut incremental, &store, &changes);
+    assert!(!incremental.contains(edge));
+    assert_eq!(sorted(&incremental), reference(&store));
+}
+
 #[test]
 fn incremental_equals_from_scratch_after_random_scans() {
-    let config = config();
-    let mut store = ChunkStore::new(&config);
-    let mut totals = StatSums::default();
+    let mut store = ChunkStore::new(&config());
     let mut counter = ScanCounter::default();
-    let inc = LogOddsIncrements {
-        hit: 847,
-        miss: -405,
-    };
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     let mut incremental = FrontierSet::default();
-    for scan in 0..25 {
-        let origin = Vec3::new(
-            rng.random_range(-2.5..2.5),
-            rng.random_range(-2.5..2.5),
-            rng.random_range(-2.5..2.5),
-        );
-        let mut endpoints = Vec::new();
-        let mut hit = Vec::new();
-        for _ in 0..60 {
-            let dir = Vec3::new(
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-            );
-            endpoints.push(origin + dir.normalize_or(Vec3::X) * rng.random_range(0.2..4.0));
-            hit.push(rng.random_bool(0.5));
-        }
-        let rays = ScanRays {
-            origin,
-            endpoints: &endpoints,
-            hit: &hit,
-        };
-        integrate_scan(
-            &config,
-            counter.next_id(),
-            rays,
-            inc,
-            &mut store,
-            &mut totals,
-        )
-        .unwrap();
-        let written = store.take_written();
-        update_frontier_set(&mut incremental, &store, &written);
-        if scan % 8 == 0 || scan == 24 {
+    let mut neighbours_skipped = false;
+    // Few rays per scan: a changed chunk's neighbours are often unchanged themselves.
+    for scan in 0..40 {
+        integrate_random_scan(&mut store, &mut counter, &mut rng, 2.5, 6);
+        // Where states changed, as the engine reports it (`StateChanges`): face neighbours
+        // are re-examined only where a changed brick touches them.
+        let changes = store.take_state_changes();
+        neighbours_skipped |= changes.iter().any(|c| !c.reaches(IVec3::X, 1));
+        update_frontier_set(&mut incremental, &store, &changes);
+        if scan % 4 == 3 {
             let mut scratch = FrontierSet::default();
             update_frontier_set(&mut scratch, &store, &all_chunks(&store));
             let expected = reference(&store);
@@ -245,4 +262,5 @@ fn incremental_equals_from_scratch_after_random_scans() {
             );
         }
     }
+    assert!(neighbours_skipped);
 }

@@ -242,7 +242,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let index = local_index(key) & (CHUNK_VOXELS - 1);
         let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
         if change.state_changed() {
-            chunk.note_state_change();
+            chunk.note_state_changes_in(self.scan, 1 << brick_of(index));
         }
         if change.changed() {
             // A voxel's statistics change only with its log-odds.
@@ -438,7 +438,8 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let mut changed = 0u64;
             let mut skipped = 0u64;
             let mut cubes = [0u64; 3];
-            let mut states_changed = false;
+            // The bricks where a voxel's state changed (`VoxelChunk::note_state_changes_in`).
+            let mut state_bricks = 0u64;
             loop {
                 let index = cursor.index();
                 let brick = brick_of(index);
@@ -479,7 +480,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 }
                 let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
                 changed += u64::from(change.changed());
-                states_changed |= change.state_changed();
+                state_bricks |= u64::from(change.state_changed()) << brick;
                 visits -= 1;
                 if visits == 0 {
                     break;
@@ -506,9 +507,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             for (total, crossed) in self.report.cubes_crossed.iter_mut().zip(cubes) {
                 *total += crossed;
             }
-            if states_changed {
-                chunk.note_state_change();
-            }
+            chunk.note_state_changes_in(self.scan, state_bricks);
             if changed > 0 {
                 // Statistics change only with log-odds: most visits (crossings of saturated
                 // cubes, voxels seen again) change none.

@@ -29,9 +29,9 @@ pub mod update;
 
 pub use integrate::{ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan};
 pub use read::{MapReader, OccupancyMap, map_accuracy};
-pub use state_changes::StateChanges;
+pub use state_changes::{StateChange, StateChanges};
 pub use store::ChunkStore;
 pub use system::{MappingScratch, insert_map_resources, integrate_scans};
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -3,6 +3,7 @@
 
 use super::integrate::ChunkAccess;
 use super::read::OccupancyMap;
+use super::state_changes::StateChange;
 use uavex_components::map::{ChunkCoord, ChunkGrid, MapConfig, StatSums, VoxelChunk};
 
 /// Chunks with their statistics, by flat chunk index, plus which chunks were written since
@@ -13,6 +14,8 @@ pub struct ChunkStore {
     chunks: Vec<Option<(VoxelChunk, StatSums)>>,
     written_flags: Vec<bool>,
     written: Vec<usize>,
+    /// Per chunk, the state version [`ChunkStore::take_state_changes`] last saw.
+    seen_versions: Vec<Option<u32>>,
 }
 
 impl ChunkStore {
@@ -23,6 +26,7 @@ impl ChunkStore {
             chunks: vec![None; n],
             written_flags: vec![false; n],
             written: Vec::new(),
+            seen_versions: vec![None; n],
         }
     }
 
@@ -51,6 +55,30 @@ impl ChunkStore {
             .drain(..)
             .map(|flat| grid.coord(flat))
             .collect()
+    }
+
+    /// The chunks written since the last call whose voxel states changed, and where (as the
+    /// engine's `StateChanges` reports them; every brick the first time a chunk is seen);
+    /// clears the record of written chunks.
+    pub fn take_state_changes(&mut self) -> Vec<StateChange> {
+        let grid = self.grid();
+        let written = std::mem::take(&mut self.written);
+        let mut changes = Vec::new();
+        for flat in written {
+            self.written_flags[flat] = false;
+            let Some((chunk, _)) = &self.chunks[flat] else {
+                continue;
+            };
+            let seen = self.seen_versions[flat].replace(chunk.state_version());
+            let bricks = chunk.state_changed_bricks_since(seen);
+            if bricks != 0 {
+                changes.push(StateChange {
+                    coord: grid.coord(flat),
+                    bricks,
+                });
+            }
+        }
+        changes
     }
 }
 

@@ -16,6 +16,53 @@ const OCTOMAP: LogOddsIncrements = LogOddsIncrements {
     miss: -405,
 };
 
+/// Integrates into `store` one scan from `origin` of the rays `(end, hit)`, with the OctoMap
+/// increments: a test of the consumers of the map update (frontiers, traversability).
+pub(crate) fn integrate_rays(
+    store: &mut ChunkStore,
+    counter: &mut ScanCounter,
+    origin: Vec3,
+    rays: &[(Vec3, bool)],
+) {
+    let (endpoints, hit): (Vec<Vec3>, Vec<bool>) = rays.iter().copied().unzip();
+    let rays = ScanRays {
+        origin,
+        endpoints: &endpoints,
+        hit: &hit,
+    };
+    let config = store.config().clone();
+    let mut totals = StatSums::default();
+    integrate_scan(
+        &config,
+        counter.next_id(),
+        rays,
+        OCTOMAP,
+        store,
+        &mut totals,
+    )
+    .unwrap();
+}
+
+/// [`integrate_rays`] with `rays` random rays (directions uniform in a cube, 0.2 to 4 m long,
+/// half of them hits) from a random origin within `half_extent` m of 0 on each axis.
+pub(crate) fn integrate_random_scan(
+    store: &mut ChunkStore,
+    counter: &mut ScanCounter,
+    rng: &mut ChaCha8Rng,
+    half_extent: f32,
+    rays: usize,
+) {
+    let origin = Vec3::from_array([0; 3].map(|_| rng.random_range(-half_extent..half_extent)));
+    let rays: Vec<(Vec3, bool)> = (0..rays)
+        .map(|_| {
+            let dir = Vec3::from_array([0; 3].map(|_| rng.random_range(-1.0..1.0)));
+            let end = origin + dir.normalize_or(Vec3::X) * rng.random_range(0.2..4.0);
+            (end, rng.random_bool(0.5))
+        })
+        .collect();
+    integrate_rays(store, counter, origin, &rays);
+}
+
 /// Keys -32..=31 on each axis at 0.1 m: chunks -2..=1.
 fn config() -> MapConfig {
     MapConfig::new(&MapSettings {

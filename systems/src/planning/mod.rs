@@ -38,9 +38,8 @@ pub use search::{SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
 pub use sight::SightMemo;
 pub use traversable::TraversableGrid;
 
-use crate::mapping::StateChanges;
+use crate::mapping::{StateChange, StateChanges};
 use bevy_ecs::prelude::*;
-use uavex_components::map::ChunkCoord;
 
 /// The traversability grid of the shared map, as a resource.
 #[derive(Resource, Debug, Clone)]
@@ -53,14 +52,14 @@ pub struct Traversability(pub TraversableGrid);
 pub fn track_traversability(
     grid: Option<ResMut<Traversability>>,
     mut changes: StateChanges,
-    mut scratch: Local<Vec<ChunkCoord>>,
+    mut scratch: Local<Vec<StateChange>>,
 ) {
     let Some(mut grid) = grid else {
         return;
     };
     scratch.clear();
     changes.collect_into(&mut scratch);
-    for coord in scratch.iter() {
-        grid.0.mark_changed(*coord);
+    for change in scratch.iter() {
+        grid.0.mark_state_change(*change);
     }
 }

@@ -56,10 +56,10 @@ impl TestMap {
         self.fill(self.config.key_min(), self.config.key_max(), log_odds);
     }
 
-    /// A grid refreshed from the chunks written since the last call.
+    /// A grid refreshed from the chunks whose states changed since the last call.
     pub fn update(&mut self, grid: &mut TraversableGrid) {
-        for coord in self.store.take_written() {
-            grid.mark_changed(coord);
+        for change in self.store.take_state_changes() {
+            grid.mark_state_change(change);
         }
         grid.refresh(&self.store);
     }
@@ -228,6 +228,43 @@ fn random_maps_follow_the_rule_and_incremental_refresh_equals_scratch() {
             traversable += usize::from(expected);
         }
         assert!(traversable > 0);
+    }
+}
+
+/// A scan that writes only one chunk still blocks the voxels of the next chunk within the
+/// inflation of what it found: that chunk is refreshed, though not written.
+#[test]
+fn a_scan_that_writes_one_chunk_blocks_across_its_face() {
+    use crate::mapping::tests::integrate_rays;
+    use glam::Vec3;
+    use uavex_components::map::ScanCounter;
+    // Chunks 0 and 1 along x, all known free but for a lone unknown voxel (which blocks
+    // nothing) at (17, 8, 8), two voxels from chunk 0's face.
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(3.2, 1.6, 1.6));
+    map.fill_all(FREE);
+    let hole = IVec3::new(17, 8, 8);
+    map.set(hole, i16::MIN);
+    let mut incremental = TraversableGrid::new(&map.config, 0.27);
+    map.update(&mut incremental);
+    let near = IVec3::new(15, 8, 8);
+    assert!(incremental.is_traversable(near));
+    // A ray from inside chunk 1 hits the hole: occupied now, it blocks `near` (2 voxels away).
+    let centre = |x: f32| Vec3::new(x, 0.85, 0.85);
+    let mut counter = ScanCounter::default();
+    integrate_rays(
+        &mut map.store,
+        &mut counter,
+        centre(2.45),
+        &[(centre(1.75), true)],
+    );
+    map.update(&mut incremental);
+    assert!(!incremental.is_traversable(near));
+    for key in keys(&map.config, 1) {
+        assert_eq!(
+            incremental.is_traversable(key),
+            expected_traversable(&map, key, 2.7),
+            "{key}"
+        );
     }
 }
 

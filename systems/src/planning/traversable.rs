@@ -29,7 +29,7 @@
 //! a few thousand word operations per chunk.
 
 use super::lattice::Lattice;
-use crate::mapping::OccupancyMap;
+use crate::mapping::{OccupancyMap, StateChange};
 use glam::{DVec3, IVec3};
 use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, Voxel, floor_to_key};
 
@@ -129,20 +129,30 @@ impl TraversableGrid {
             && self.key_max == config.key_max()
     }
 
-    /// A map chunk changed: it and every chunk the inflation reaches from it become dirty.
-    /// Chunks outside the map's chunk grid are ignored.
+    /// A map chunk changed anywhere: it and every chunk the inflation reaches from it become
+    /// dirty. Chunks outside the map's chunk grid are ignored.
     pub fn mark_changed(&mut self, chunk: ChunkCoord) {
-        if self.chunk_grid.flat(chunk).is_none() {
+        self.mark_state_change(chunk.into());
+    }
+
+    /// Voxel states changed in some bricks of a map chunk: it and every chunk the inflation
+    /// reaches from those bricks become dirty. Chunks outside the map's chunk grid are ignored.
+    pub fn mark_state_change(&mut self, change: StateChange) {
+        if self.chunk_grid.flat(change.coord).is_none() {
             return;
         }
         // The inflation reaches `reach` voxels, and whether an unknown voxel blocks depends on
         // its neighbours one voxel further.
-        let span = (self.reach + 1 + EDGE - 1) / EDGE;
+        let margin = self.reach + 1;
+        let span = (margin + EDGE - 1) / EDGE;
         for dz in -span..=span {
             for dy in -span..=span {
                 for dx in -span..=span {
-                    let neighbour = ChunkCoord(chunk.0 + IVec3::new(dx, dy, dz));
-                    if let Some(flat) = self.chunk_grid.flat(neighbour) {
+                    let offset = IVec3::new(dx, dy, dz);
+                    if !change.reaches(offset, margin) {
+                        continue;
+                    }
+                    if let Some(flat) = self.chunk_grid.flat(ChunkCoord(change.coord.0 + offset)) {
                         self.mark_flat(flat);
                     }
                 }

@@ -159,6 +159,10 @@ const MAX_NEAR_OBSTACLES: usize = 8;
 /// sweep, about 2 us for 64); larger worlds use the hierarchy.
 const MAX_SCANNED_OBSTACLES: usize = 64;
 
+/// Relative and absolute margin (m) of [`NearObstacle::nearest`]: the ray tests round to a few
+/// ulps of f32 (1e-7 relative), the directions are unit vectors to as many.
+const NEAREST_MARGIN: f32 = 1e-4;
+
 /// Rays per parallel task for long batches (as `WorldGeometry::cast_rays`).
 const PARALLEL_RAY_CHUNK: usize = 1024;
 
@@ -166,6 +170,10 @@ const PARALLEL_RAY_CHUNK: usize = 1024;
 #[derive(Debug, Clone, Copy)]
 struct NearObstacle {
     index: usize,
+    /// A lower bound of the distance from the sweep's origin to the obstacle: its bounding
+    /// box's distance, less a margin far above the rounding of the ray tests, so that no hit on
+    /// it can come nearer (0 from inside the box).
+    nearest: f32,
     /// The sensor origin in the obstacle's frame (`pose.inverse_transform_point(origin)`).
     local_origin: Vec3,
     /// Rotation from the world frame to the obstacle's frame (`pose.rotation.inverse()`).
@@ -182,6 +190,9 @@ struct NearObstacle {
 /// obstacles' own ray tests (benches/sensing.rs). The per-shape test is parry's own
 /// (`cast_ray` is `cast_local_ray` of the ray moved into the shape's frame by the same two
 /// operations), and the nearest hit closer than the range wins, as in the hierarchy's search.
+/// The obstacles are tried nearest box first, and a ray stops trying once the next box lies
+/// beyond its nearest hit so far: the shape in that box can only be hit farther away (in a
+/// room, most rays end on the floor, a wall or a pillar before reaching the others' boxes).
 fn cast_sweep(
     world: &WorldGeometry,
     origin: Vec3,
@@ -200,18 +211,23 @@ fn cast_sweep(
     let range_box = Aabb::new(origin - reach, origin + reach);
     near.clear();
     for (index, obstacle) in world.obstacles().iter().enumerate() {
-        if obstacle.aabb().intersects(&range_box) {
+        let aabb = obstacle.aabb();
+        if aabb.intersects(&range_box) {
             if near.len() == MAX_NEAR_OBSTACLES {
                 world.cast_rays(origin, directions, range, out);
                 return;
             }
+            let gap = (aabb.mins - origin).max(origin - aabb.maxs).max(Vec3::ZERO);
             near.push(NearObstacle {
                 index,
+                nearest: gap.length() * (1.0 - NEAREST_MARGIN) - NEAREST_MARGIN,
                 local_origin: obstacle.pose.inverse_transform_point(origin),
                 to_local: obstacle.pose.rotation.inverse(),
             });
         }
     }
+    // Nearest first (ties in the world's order: a stable sort).
+    near.sort_by(|a, b| a.nearest.total_cmp(&b.nearest));
     out.clear();
     out.resize(directions.len(), None);
     let obstacles = world.obstacles();
@@ -220,6 +236,9 @@ fn cast_sweep(
             let mut best = range;
             let mut hit = false;
             for n in near.iter() {
+                if n.nearest > best {
+                    break;
+                }
                 let ray = Ray::new(n.local_origin, n.to_local * *dir);
                 let shape = &obstacles[n.index].shape;
                 if let Some(toi) = shape.cast_local_ray(&ray, best, true)
@@ -361,6 +380,38 @@ mod tests {
             );
         }
         near.len()
+    }
+
+    /// A ray that already hit the floor far away still tries a box whose bounding box begins
+    /// before that hit, and hits it nearer.
+    #[test]
+    fn a_box_nearer_than_the_hit_so_far_is_still_tried() {
+        let world = WorldGeometry::new(vec![
+            cuboid(
+                "floor",
+                Vec3::new(0.0, 0.0, -0.1),
+                Vec3::new(40.0, 40.0, 0.2),
+                0.0,
+            ),
+            cuboid(
+                "post",
+                Vec3::new(3.85, 0.0, 0.5),
+                Vec3::new(0.2, 2.0, 1.0),
+                0.0,
+            ),
+        ])
+        .unwrap();
+        let origin = Vec3::new(0.0, 0.0, 1.0);
+        // Down to the floor 4.12 m away; the post's box begins 3.75 m away, the ray meets it
+        // at 3.87 m.
+        let directions = [Vec3::new(4.0, 0.0, -1.0).normalize()];
+        let (mut near, mut direct, mut reference) = (Vec::new(), Vec::new(), Vec::new());
+        cast_sweep(&world, origin, &directions, 5.0, &mut near, &mut direct);
+        world.cast_rays(origin, &directions, 5.0, &mut reference);
+        assert_eq!(near.len(), 2);
+        let hit = direct[0].expect("a hit");
+        assert!((hit - 3.75 * 4.0f32.hypot(1.0) / 4.0).abs() < 1e-4, "{hit}");
+        assert_eq!(direct, reference);
     }
 
     /// The direct casts give the hierarchy's distances to the bit, whether a ray hits a face, an

@@ -24,7 +24,7 @@ use uavex_components::sim::{Outcome, SimClock};
 use uavex_components::uav::{PredictedMission, Uav, UavEnded};
 use uavex_components::world::WorldGeometry;
 use uavex_systems::flight::{EnergySummary, FlightEnergy};
-use uavex_systems::mapping::{MapReader, OccupancyMap, map_accuracy};
+use uavex_systems::mapping::{MapReader, OccupancyMap, WorldVoxels, map_accuracy};
 use uavex_systems::stage_clock::StageClock;
 
 /// How to run a scenario.
@@ -131,7 +131,13 @@ fn summarise(sim: &mut Sim, name: &str, seed: u64, outcome: Outcome, reason: Str
     let accuracy = with_map(world, |reader, world| {
         let geometry = world.resource::<WorldGeometry>();
         let resolution = reader.config().resolution() as f32;
-        map_accuracy(reader, |key| geometry.voxel_key_occupied(key, resolution))
+        map_accuracy(
+            reader,
+            WorldVoxels {
+                geometry,
+                resolution,
+            },
+        )
     })
     .flatten();
     let mut uavs: Vec<UavEnding> = world

@@ -63,6 +63,22 @@ impl WorldGeometry {
         self.voxel_occupied(center.as_vec3(), resolution)
     }
 
+    /// Whether some voxel of the keys `lo..=hi` may be occupied ([`Self::voxel_key_occupied`]):
+    /// false only when no obstacle's bounding box meets the box of those voxels, each shrunk as
+    /// there (by half the shrink, a margin far above rounding). One bounding-volume query for a
+    /// whole block of voxels, most of which lie in open space.
+    pub fn voxel_keys_may_be_occupied(&self, lo: IVec3, hi: IVec3, resolution: f32) -> bool {
+        if self.obstacles.is_empty() {
+            return false;
+        }
+        let margin = 0.5 * f64::from(VOXEL_SHRINK) * f64::from(resolution);
+        let r = f64::from(resolution);
+        let min = lo.as_dvec3() * r + margin;
+        let max = (hi + IVec3::ONE).as_dvec3() * r - margin;
+        let probe = Aabb::new(min.as_vec3(), max.as_vec3());
+        self.bvh.intersect_aabb(&probe).next().is_some()
+    }
+
     /// The first obstacle intersecting `shape` at `pose`; `center` is a point inside the shape,
     /// used for the inside test of closed meshes.
     fn first_intersecting(&self, pose: &Pose, shape: &dyn Shape, center: Vec3) -> Option<usize> {

@@ -340,3 +340,54 @@ fn non_finite_obstacles_are_refused() {
     assert!(err.to_string().contains("'bad'"), "{err}");
     assert!(WorldGeometry::new(Vec::new()).unwrap().aabb().is_none());
 }
+
+/// A block of voxels said to be free holds no occupied voxel, and the blocks beside a box's
+/// faces, which only touch it, are said free: checked block by block around a yawed box and a
+/// cylinder, against the voxel test.
+#[test]
+fn voxel_blocks_said_free_hold_no_occupied_voxel() {
+    let w = world(vec![
+        box_obstacle(
+            "box",
+            Vec3::new(0.5, 1.0, 0.25),
+            Vec3::new(1.0, 2.0, 0.5),
+            0.0,
+        ),
+        box_obstacle(
+            "yawed",
+            Vec3::new(-1.0, -1.0, 0.5),
+            Vec3::new(0.6, 0.3, 1.0),
+            0.4,
+        ),
+        cylinder_obstacle(Vec3::new(1.5, -1.5, 0.0), 0.3, 1.0),
+    ]);
+    let res = 0.1;
+    // The block of keys 10..=13 on x beside the box's face at x = 1: free.
+    let beside = IVec3::new(10, 4, 0);
+    assert!(!w.voxel_keys_may_be_occupied(beside, beside + IVec3::splat(3), res));
+    assert!(w.voxel_keys_may_be_occupied(beside - IVec3::X, beside + IVec3::splat(3), res));
+    let (mut free_blocks, mut checked) = (0, 0);
+    for bz in -2..4 {
+        for by in -6..7 {
+            for bx in -6..6 {
+                let lo = IVec3::new(bx, by, bz) * 4;
+                let hi = lo + IVec3::splat(3);
+                if w.voxel_keys_may_be_occupied(lo, hi, res) {
+                    continue;
+                }
+                free_blocks += 1;
+                for z in lo.z..=hi.z {
+                    for y in lo.y..=hi.y {
+                        for x in lo.x..=hi.x {
+                            let key = IVec3::new(x, y, z);
+                            assert!(!w.voxel_key_occupied(key, res), "{key} in {lo}");
+                            checked += 1;
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(free_blocks > 100 && checked == 64 * free_blocks);
+    assert!(!world(Vec::new()).voxel_keys_may_be_occupied(IVec3::ZERO, IVec3::ONE, res));
+}

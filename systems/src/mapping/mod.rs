@@ -28,7 +28,7 @@ pub mod system;
 pub mod update;
 
 pub use integrate::{ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan};
-pub use read::{MapReader, OccupancyMap, map_accuracy};
+pub use read::{GroundTruth, MapReader, OccupancyMap, WorldVoxels, map_accuracy};
 pub use state_changes::{StateChange, StateChanges};
 pub use store::ChunkStore;
 pub use system::{MappingScratch, insert_map_resources, integrate_scans};

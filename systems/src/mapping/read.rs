@@ -6,9 +6,10 @@ use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemParam;
 use glam::IVec3;
 use uavex_components::map::{
-    CHUNK_VOXELS, ChunkCoord, ChunkIndex, MapConfig, UNKNOWN_LOG_ODDS, VoxelChunk, VoxelState,
-    local_index, local_key, milli_to_log_odds,
+    BRICK_EDGE, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkIndex, MapConfig, UNKNOWN_LOG_ODDS,
+    VoxelChunk, VoxelState, local_index, local_key, milli_to_log_odds,
 };
+use uavex_components::world::WorldGeometry;
 
 /// Read-only occupancy queries (common.md §1 semantics: unknown until observed, occupied when
 /// l >= 0, free otherwise).
@@ -61,13 +62,69 @@ pub trait OccupancyMap {
     }
 }
 
-/// Fraction of known voxels whose state agrees with the ground truth `is_occupied(key)`;
-/// `None` while no voxel is known.
-pub fn map_accuracy(map: &impl OccupancyMap, is_occupied: impl Fn(IVec3) -> bool) -> Option<f64> {
+/// The truth a map is measured against ([`map_accuracy`]): any `Fn(IVec3) -> bool` telling
+/// whether a voxel key is occupied, or [`WorldVoxels`].
+pub trait GroundTruth {
+    /// Whether voxel `key` is occupied.
+    fn occupied(&self, key: IVec3) -> bool;
+
+    /// Whether some voxel of the keys `lo..=hi` may be occupied; false only if none is (a
+    /// quick answer for a block of voxels, so that open space is not asked voxel by voxel).
+    fn may_be_occupied(&self, _lo: IVec3, _hi: IVec3) -> bool {
+        true
+    }
+}
+
+impl<F: Fn(IVec3) -> bool> GroundTruth for F {
+    fn occupied(&self, key: IVec3) -> bool {
+        self(key)
+    }
+}
+
+/// The world's obstacles as the ground truth of a map of voxels of edge `resolution`
+/// ([`WorldGeometry::voxel_key_occupied`]).
+pub struct WorldVoxels<'a> {
+    pub geometry: &'a WorldGeometry,
+    pub resolution: f32,
+}
+
+impl GroundTruth for WorldVoxels<'_> {
+    fn occupied(&self, key: IVec3) -> bool {
+        self.geometry.voxel_key_occupied(key, self.resolution)
+    }
+
+    fn may_be_occupied(&self, lo: IVec3, hi: IVec3) -> bool {
+        self.geometry
+            .voxel_keys_may_be_occupied(lo, hi, self.resolution)
+    }
+}
+
+/// Fraction of known voxels whose state agrees with the ground truth; `None` while no voxel
+/// is known. Brick by brick: a brick the truth says is all free is not asked voxel by voxel.
+pub fn map_accuracy(map: &impl OccupancyMap, truth: impl GroundTruth) -> Option<f64> {
     let (mut known, mut agree) = (0u64, 0u64);
-    for (key, log_odds) in map.known_voxels() {
-        known += 1;
-        agree += u64::from((log_odds >= 0.0) == is_occupied(key));
+    let bricks = CHUNK_EDGE / BRICK_EDGE;
+    for (coord, chunk) in map.chunks() {
+        for b in 0..bricks * bricks * bricks {
+            let brick = IVec3::new(b % bricks, b / bricks % bricks, b / (bricks * bricks));
+            let lo = coord.first_key() + brick * BRICK_EDGE;
+            let hi = lo + IVec3::splat(BRICK_EDGE - 1);
+            let open = !truth.may_be_occupied(lo, hi);
+            for z in lo.z..=hi.z {
+                for y in lo.y..=hi.y {
+                    for x in lo.x..=hi.x {
+                        let key = IVec3::new(x, y, z);
+                        let l = chunk.log_odds_milli(local_index(key));
+                        if l == UNKNOWN_LOG_ODDS {
+                            continue;
+                        }
+                        known += 1;
+                        let occupied = !open && truth.occupied(key);
+                        agree += u64::from((l >= 0) == occupied);
+                    }
+                }
+            }
+        }
     }
     (known > 0).then(|| agree as f64 / known as f64)
 }

@@ -338,9 +338,46 @@ fn accuracy_against_a_ground_truth() {
     let mut m = Mapper::new();
     m.scan(ORIGIN, &[(Vec3::new(1.0, 0.05, 0.05), true)]);
     // Truth: occupied for x >= 1.0 m (key 10): all 11 known voxels agree.
-    assert_eq!(map_accuracy(&m.store, |k| k.x >= 10), Some(1.0));
-    assert_eq!(map_accuracy(&m.store, |_| false), Some(10.0 / 11.0));
-    assert_eq!(map_accuracy(&Mapper::new().store, |_| true), None);
+    assert_eq!(map_accuracy(&m.store, |k: IVec3| k.x >= 10), Some(1.0));
+    assert_eq!(map_accuracy(&m.store, |_: IVec3| false), Some(10.0 / 11.0));
+    assert_eq!(map_accuracy(&Mapper::new().store, |_: IVec3| true), None);
+}
+
+/// Against the world's obstacles, skipping the bricks the world says are open gives the
+/// accuracy of asking every voxel.
+#[test]
+fn accuracy_against_the_world_skips_open_bricks_exactly() {
+    use parry3d::math::Pose;
+    use parry3d::shape::SharedShape;
+    use uavex_components::world::{Obstacle, WorldGeometry};
+    let geometry = WorldGeometry::new(vec![Obstacle::new(
+        "box",
+        "test",
+        Pose::from_translation(Vec3::new(1.0, 1.0, 0.5)),
+        SharedShape::cuboid(0.5, 0.7, 0.5),
+    )])
+    .unwrap();
+    let mut store = ChunkStore::new(&config());
+    let (mut counter, mut rng) = (ScanCounter::default(), ChaCha8Rng::seed_from_u64(3));
+    for _ in 0..20 {
+        integrate_random_scan(&mut store, &mut counter, &mut rng, 2.0, 200);
+    }
+    let resolution = 0.1;
+    // The reference asks every known voxel.
+    let (known, agree) = store.known_voxels().fold((0u64, 0u64), |(n, a), (key, l)| {
+        let occupied = geometry.voxel_key_occupied(key, resolution);
+        (n + 1, a + u64::from((l >= 0.0) == occupied))
+    });
+    let every_voxel = Some(agree as f64 / known as f64);
+    let by_brick = map_accuracy(
+        &store,
+        WorldVoxels {
+            geometry: &geometry,
+            resolution,
+        },
+    );
+    assert!(every_voxel.is_some_and(|a| a < 1.0));
+    assert_eq!(by_brick, every_voxel);
 }
 
 /// After random scans (rays inside, leaving and entering the map, hits and max-range cuts,

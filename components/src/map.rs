@@ -20,8 +20,8 @@ mod saturation;
 mod stats;
 
 pub use chunk::{
-    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ScanId, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk, VoxelState,
-    local_index, local_key,
+    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, RowStates, ScanId, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk,
+    VoxelState, local_index, local_key,
 };
 pub use config::{
     LogOddsIncrements, MAX_BOX_VOXELS, MapConfig, MapConfigError, MapSettings, floor_to_key,

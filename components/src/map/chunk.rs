@@ -157,6 +157,22 @@ impl Voxel {
     }
 }
 
+/// The states of the 16 voxels of one x-row of a chunk, bit x for voxel x
+/// ([`VoxelChunk::row_states`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RowStates {
+    pub unknown: u16,
+    pub occupied: u16,
+}
+
+impl RowStates {
+    /// The free voxels: known and not occupied.
+    #[inline]
+    pub fn free(self) -> u16 {
+        !(self.unknown | self.occupied)
+    }
+}
+
 /// The voxels of one chunk, indexed by [`local_index`], plus the stamp epoch and, per brick,
 /// how many of its voxels are saturated free.
 ///
@@ -316,6 +332,21 @@ impl VoxelChunk {
             .fold(0u16, |bits, (x, &v)| bits | (u16::from(pred(v)) << x))
     }
 
+    /// The states of the voxels of row `row` (as [`Self::row_bits`]) in one pass: frontiers
+    /// and traversability need two of the three states of every row they read, and one pass
+    /// reads the voxels once.
+    #[inline]
+    pub fn row_states(&self, row: usize) -> RowStates {
+        let start = (row * CHUNK_EDGE as usize) % CHUNK_VOXELS;
+        let voxels = &self.voxels[start..start + CHUNK_EDGE as usize];
+        let (mut unknown, mut occupied) = (0u16, 0u16);
+        for (x, v) in voxels.iter().enumerate() {
+            unknown |= u16::from(v.is_unknown()) << x;
+            occupied |= u16::from(v.log_odds >= 0) << x;
+        }
+        RowStates { unknown, occupied }
+    }
+
     /// Stored log-odds (milli units) at local index `index`.
     #[inline]
     pub fn log_odds_milli(&self, index: usize) -> i16 {
@@ -381,6 +412,24 @@ mod tests {
             }
             let bits = chunk.row_bits(row, |v| v.log_odds > 0);
             assert_eq!(bits, pattern, "row {row}");
+        }
+    }
+
+    /// Row states agree with the voxel predicates on every state pattern of a row.
+    #[test]
+    fn row_states_agree_with_the_voxel_predicates() {
+        let mut chunk = VoxelChunk::new();
+        let values = [UNKNOWN_LOG_ODDS, -1992, -1, 0, 847];
+        for pattern in 0..5u32.pow(6) {
+            let row = pattern as usize % 256;
+            for x in 0..16 {
+                let value = values[(pattern / 5u32.pow(x as u32 % 6)) as usize % 5];
+                chunk.voxels_mut()[row * 16 + x].log_odds = value;
+            }
+            let states = chunk.row_states(row);
+            assert_eq!(states.unknown, chunk.row_bits(row, Voxel::is_unknown));
+            assert_eq!(states.occupied, chunk.row_bits(row, Voxel::is_occupied));
+            assert_eq!(states.free(), chunk.row_bits(row, Voxel::is_free));
         }
     }
 

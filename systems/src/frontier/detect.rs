@@ -69,27 +69,27 @@ pub fn chunk_frontier(map: &impl OccupancyMap, coord: ChunkCoord) -> VoxelMask {
     let Some(chunk) = map.chunk(coord) else {
         return out;
     };
+    // unknown[pz][py]: bit px of the padded row (local coordinates shifted by +1), only for the
+    // interior rows and the six face layers (edges and corners are no 6-neighbour of the chunk).
     let mut free = [0u16; EDGE * EDGE];
+    let mut unknown = [[0u32; PADDED]; PADDED];
     for z in 0..EDGE {
         for y in 0..EDGE {
-            free[y + EDGE * z] = row_bits(chunk, y, z, Voxel::is_free);
+            let states = chunk.row_states(y + EDGE * z);
+            free[y + EDGE * z] = states.free();
+            unknown[z + 1][y + 1] = u32::from(states.unknown) << 1;
         }
     }
     if free.iter().all(|&r| r == 0) {
         return out;
     }
-
-    // unknown[pz][py]: bit px of the padded row (local coordinates shifted by +1), only for the
-    // interior rows and the six face layers (edges and corners are no 6-neighbour of the chunk).
-    let mut unknown = [[0u32; PADDED]; PADDED];
     let neighbour = |d: IVec3| map.chunk(ChunkCoord(coord.0 + d));
     let (nx, px) = (neighbour(IVec3::NEG_X), neighbour(IVec3::X));
     for z in 0..EDGE {
         for y in 0..EDGE {
-            let inner = u32::from(row_bits(chunk, y, z, Voxel::is_unknown)) << 1;
             let low = u32::from(unknown_voxel(nx, EDGE - 1, y, z));
             let high = u32::from(unknown_voxel(px, 0, y, z)) << (EDGE + 1);
-            unknown[z + 1][y + 1] = inner | low | high;
+            unknown[z + 1][y + 1] |= low | high;
         }
     }
     let (ny, py) = (neighbour(IVec3::NEG_Y), neighbour(IVec3::Y));

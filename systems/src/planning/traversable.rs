@@ -473,10 +473,8 @@ impl TraversableGrid {
                             let i = (y - halo_min.y) as usize + gw * (z - halo_min.z) as usize;
                             let assumed_row = assumed.map_or(0, |a| a[local_row]);
                             let (known, occupied) = chunk.map_or((0, 0), |chunk| {
-                                (
-                                    !chunk.row_bits(local_row, Voxel::is_unknown),
-                                    chunk.row_bits(local_row, Voxel::is_occupied),
-                                )
+                                let states = chunk.row_states(local_row);
+                                (!states.unknown, states.occupied)
                             });
                             // An assumed-free voxel is known and not occupied, whatever the map
                             // holds.

@@ -60,7 +60,9 @@ pub struct TraversableGrid {
     inflation_m: f64,
     /// Inflation in whole voxels (the halo width).
     reach: i32,
-    ball: Vec<BallRow>,
+    /// The inflation ball's rows ([`BallRow`]) as offsets into `dilated` from the halo's
+    /// first row: `half_width` planes up, `reach + dy` rows and `reach + dz` row planes on.
+    ball: Vec<usize>,
     /// Per chunk, by flat index; `None` when nothing in it is traversable.
     chunks: Vec<Option<Box<ChunkRows>>>,
     /// Voxels known free without a sensor (see [`TraversableGrid::assume_free_ball`]), per
@@ -93,6 +95,13 @@ impl TraversableGrid {
         let chunk_grid = config.chunk_grid();
         let n = chunk_grid.len();
         let width = (EDGE + 2 * reach) as usize;
+        let ball = ball
+            .iter()
+            .map(|row| {
+                let (hy, hz) = ((reach + row.dy) as usize, (reach + row.dz) as usize);
+                row.half_width as usize * width * width + hy + width * hz
+            })
+            .collect();
         Self {
             resolution,
             key_min: config.key_min(),
@@ -385,14 +394,14 @@ impl TraversableGrid {
             }
         }
         let mut blocked = [0u16; ROWS];
-        for lz in 0..EDGE {
-            for ly in 0..EDGE {
-                let mut bits = 0u64;
-                for row in &self.ball {
-                    let (hy, hz) = ((ly + r + row.dy) as usize, (lz + r + row.dz) as usize);
-                    bits |= self.dilated[row.half_width as usize * plane + hy + w * hz];
-                }
-                blocked[(ly + EDGE * lz) as usize] = (bits >> r) as u16;
+        for lz in 0..EDGE as usize {
+            for ly in 0..EDGE as usize {
+                let at = ly + w * lz;
+                let bits = self
+                    .ball
+                    .iter()
+                    .fold(0u64, |bits, &offset| bits | self.dilated[at + offset]);
+                blocked[ly + EDGE as usize * lz] = (bits >> r) as u16;
             }
         }
         blocked

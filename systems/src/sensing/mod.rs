@@ -7,8 +7,11 @@
 //! here rather than in `uavex-components` because nothing but this stage reads them; the data
 //! other stages share (`Scan`, `Mount`, `SensorQuality`) stays in `components::sensor`.
 
+mod frustum;
 mod pattern;
 mod sweep;
+
+pub use frustum::Frustum;
 
 pub use pattern::{
     LidarBeams, MAX_RAYS, PatternError, PinholeCamera, RayGrid, RayPattern, auto_grid,

@@ -4,6 +4,7 @@
 //! camera's own resolution gives one ray per pixel, the `auto` grid the coarsest grid that still
 //! sees every voxel of the map (common.md §2). A lidar casts beams at even angular steps.
 
+use super::frustum::Frustum;
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -24,6 +25,9 @@ pub struct RayPattern {
     pub range_min: f32,
     /// Rays are cut here; beyond it nothing is seen.
     pub range_max: f32,
+    /// The pyramid the directions lie in, when they all look forward (a camera's): obstacles
+    /// outside it are not tried ([`Frustum`]).
+    pub frustum: Option<Frustum>,
 }
 
 /// A pinhole depth camera (common.md §2): looks along +x, square pixels, so the vertical field
@@ -160,6 +164,7 @@ pub fn camera_pattern(
         }
     }
     Ok(RayPattern {
+        frustum: Frustum::enclosing(&directions),
         directions,
         columns,
         rows,
@@ -306,6 +311,7 @@ pub fn lidar_pattern(
         }
     }
     Ok(RayPattern {
+        frustum: Frustum::enclosing(&directions),
         directions,
         columns: lidar.beams_h,
         rows: lidar.beams_v,

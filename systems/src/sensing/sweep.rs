@@ -2,6 +2,7 @@
 //! endpoints and hit flags of a [`Scan`] (common.md §1-2).
 
 use super::RayPattern;
+use super::frustum::Frustum;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
@@ -121,6 +122,7 @@ pub fn sweep(
         world,
         pose.origin,
         &scratch.world_directions,
+        pattern.frustum.map(|f| f.rotated(pose.rotation)),
         cast_range,
         &mut scratch.near,
         &mut scratch.distances,
@@ -193,10 +195,13 @@ struct NearObstacle {
 /// The obstacles are tried nearest box first, and a ray stops trying once the next box lies
 /// beyond its nearest hit so far: the shape in that box can only be hit farther away (in a
 /// room, most rays end on the floor, a wall or a pillar before reaching the others' boxes).
+/// With the `frustum` the directions lie in (world frame), obstacles whose boxes lie outside it
+/// are not tried at all (the wall behind a camera, the pillar beside it).
 fn cast_sweep(
     world: &WorldGeometry,
     origin: Vec3,
     directions: &[Vec3],
+    frustum: Option<Frustum>,
     range: f32,
     near: &mut Vec<NearObstacle>,
     out: &mut Vec<Option<f32>>,
@@ -212,7 +217,7 @@ fn cast_sweep(
     near.clear();
     for (index, obstacle) in world.obstacles().iter().enumerate() {
         let aabb = obstacle.aabb();
-        if aabb.intersects(&range_box) {
+        if aabb.intersects(&range_box) && frustum.is_none_or(|f| !f.excludes(origin, &aabb)) {
             if near.len() == MAX_NEAR_OBSTACLES {
                 world.cast_rays(origin, directions, range, out);
                 return;
@@ -353,8 +358,13 @@ mod tests {
     }
 
     /// Casts one per-pixel camera frame from `origin` looking along `yaw`, pitched by `pitch`,
-    /// both directly and through the hierarchy; returns how many obstacles were near.
-    fn compare(world: &WorldGeometry, origin: Vec3, yaw: f32, pitch: f32, range: f32) -> usize {
+    /// both directly (passing over the obstacles outside the camera's frustum when `cull`) and
+    /// through the hierarchy; returns how many obstacles were near.
+    fn compare(
+        world: &WorldGeometry,
+        (origin, yaw, pitch, range): (Vec3, f32, f32, f32),
+        cull: bool,
+    ) -> usize {
         let camera = PinholeCamera {
             width: 320,
             height: 240,
@@ -368,7 +378,18 @@ mod tests {
         let rotation = Quat::from_rotation_z(yaw) * Quat::from_rotation_y(pitch);
         let directions: Vec<Vec3> = pattern.directions.iter().map(|d| rotation * *d).collect();
         let (mut near, mut direct, mut reference) = (Vec::new(), Vec::new(), Vec::new());
-        cast_sweep(world, origin, &directions, range, &mut near, &mut direct);
+        let frustum = pattern.frustum.map(|f| f.rotated(rotation));
+        assert!(frustum.is_some());
+        let frustum = frustum.filter(|_| cull);
+        cast_sweep(
+            world,
+            origin,
+            &directions,
+            frustum,
+            range,
+            &mut near,
+            &mut direct,
+        );
         world.cast_rays(origin, &directions, range, &mut reference);
         assert_eq!(direct.len(), directions.len());
         for (i, (a, b)) in direct.iter().zip(&reference).enumerate() {
@@ -406,7 +427,15 @@ mod tests {
         // at 3.87 m.
         let directions = [Vec3::new(4.0, 0.0, -1.0).normalize()];
         let (mut near, mut direct, mut reference) = (Vec::new(), Vec::new(), Vec::new());
-        cast_sweep(&world, origin, &directions, 5.0, &mut near, &mut direct);
+        cast_sweep(
+            &world,
+            origin,
+            &directions,
+            None,
+            5.0,
+            &mut near,
+            &mut direct,
+        );
         world.cast_rays(origin, &directions, 5.0, &mut reference);
         assert_eq!(near.len(), 2);
         let hit = direct[0].expect("a hit");
@@ -428,14 +457,20 @@ mod tests {
             (Vec3::new(0.0, 0.0, 1.5), 2.5, -0.3, 5.0),
             (Vec3::new(0.5, -0.5, 0.8), -0.785, 0.2, 4.0),
         ];
-        for (origin, yaw, pitch, range) in poses {
-            // These take the direct path.
-            assert!(compare(&world, origin, yaw, pitch, range) <= MAX_NEAR_OBSTACLES);
+        for pose in poses {
+            // These take the direct path; the frustum leaves out some obstacles of each.
+            let all = compare(&world, pose, false);
+            assert!(all <= MAX_NEAR_OBSTACLES);
+            assert!(compare(&world, pose, true) < all);
         }
-        // At 20 m all ten obstacles are near: the ninth sends the sweep to the hierarchy.
-        let far = compare(&world, Vec3::new(0.0, 0.0, 1.0), 0.0, 0.0, 20.0);
-        assert_eq!(far, MAX_NEAR_OBSTACLES);
+        // At 20 m all ten obstacles are near: the ninth sends the sweep to the hierarchy. In
+        // the camera's frustum fewer: it stays direct.
+        let far = (Vec3::new(0.0, 0.0, 1.0), 0.0, 0.0, 20.0);
+        assert_eq!(compare(&world, far, false), MAX_NEAR_OBSTACLES);
+        assert!(compare(&world, far, true) < MAX_NEAR_OBSTACLES);
         // From inside the pillar every ray stops at 0, as through the hierarchy.
-        compare(&world, Vec3::new(-0.3, -3.4, 1.0), 0.0, 0.0, 5.0);
+        for cull in [false, true] {
+            compare(&world, (Vec3::new(-0.3, -3.4, 1.0), 0.0, 0.0, 5.0), cull);
+        }
     }
 }

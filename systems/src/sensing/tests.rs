@@ -344,6 +344,7 @@ fn range_noise_is_gaussian_and_reproducible_per_stream() {
         rows: 1,
         range_min: 0.5,
         range_max: 10.0,
+        frustum: None,
     };
     let world = WorldGeometry::new(vec![wall(Vec3::new(4.5, 0.0, 0.0), Vec3::ONE)]).unwrap();
     let pose = SensorPose {

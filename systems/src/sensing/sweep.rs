@@ -6,7 +6,8 @@ use super::frustum::Frustum;
 use bevy_ecs::prelude::*;
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
-use parry3d::query::Ray;
+use parry3d::query::{Ray, RayCast};
+use parry3d::shape::Cuboid;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
@@ -180,6 +181,9 @@ struct NearObstacle {
     local_origin: Vec3,
     /// Rotation from the world frame to the obstacle's frame (`pose.rotation.inverse()`).
     to_local: Quat,
+    /// The shape when it is a box (most obstacles are): its own ray test is called directly,
+    /// not through the shape's table of methods, so that it inlines into the ray loop.
+    cuboid: Option<Cuboid>,
 }
 
 /// Casts a ray from `origin` along each of `directions` into `out`, with the result of
@@ -228,6 +232,7 @@ fn cast_sweep(
                 nearest: gap.length() * (1.0 - NEAREST_MARGIN) - NEAREST_MARGIN,
                 local_origin: obstacle.pose.inverse_transform_point(origin),
                 to_local: obstacle.pose.rotation.inverse(),
+                cuboid: obstacle.shape.as_cuboid().copied(),
             });
         }
     }
@@ -245,8 +250,11 @@ fn cast_sweep(
                     break;
                 }
                 let ray = Ray::new(n.local_origin, n.to_local * *dir);
-                let shape = &obstacles[n.index].shape;
-                if let Some(toi) = shape.cast_local_ray(&ray, best, true)
+                let toi = match &n.cuboid {
+                    Some(cuboid) => cuboid.cast_local_ray(&ray, best, true),
+                    None => obstacles[n.index].shape.cast_local_ray(&ray, best, true),
+                };
+                if let Some(toi) = toi
                     && toi < best
                 {
                     best = toi;

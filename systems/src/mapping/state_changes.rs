@@ -186,14 +186,8 @@ mod tests {
             coord: ChunkCoord(IVec3::ZERO),
             bricks: 1 << (1 + 4 + 16), // brick (1, 1, 1): voxels 4..8
         };
-        for offset in [
-            IVec3::X,
-            IVec3::NEG_X,
-            IVec3::Y,
-            IVec3::NEG_Y,
-            IVec3::Z,
-            IVec3::NEG_Z,
-        ] {
+        let faces = IVec3::AXES.into_iter().flat_map(|axis| [axis, -axis]);
+        for offset in faces {
             assert!(!inner.reaches(offset, 4), "{offset}");
             assert!(
                 inner.reaches(offset, 5) == (offset.min_element() < 0),

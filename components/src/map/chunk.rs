@@ -342,7 +342,7 @@ impl VoxelChunk {
         let (mut unknown, mut occupied) = (0u16, 0u16);
         for (x, v) in voxels.iter().enumerate() {
             unknown |= u16::from(v.is_unknown()) << x;
-            occupied |= u16::from(v.log_odds >= 0) << x;
+            occupied |= u16::from(v.is_occupied()) << x;
         }
         RowStates { unknown, occupied }
     }

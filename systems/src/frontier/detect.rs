@@ -9,10 +9,9 @@
 //! chunk, the voxels whose status may change lie in that chunk and in the face layers of its six
 //! face-neighbour chunks, of those only whose face a changed brick touches
 //! ([`StateChange::reaches`] within one voxel). [`update_frontier_set`] re-examines exactly
-//! those chunks, whole, with
-//! the row-parallel [`chunk_frontier`]: 16 voxels (one x-row) per machine word, the x neighbours
-//! by shifts and the y/z neighbours as adjacent rows, read from the chunk arrays (no per-key
-//! lookups).
+//! those chunks, whole, with the row-parallel [`chunk_frontier`]: 16 voxels (one x-row) per
+//! machine word, the x neighbours by shifts and the y/z neighbours as adjacent rows, read from
+//! the chunk arrays (no per-key lookups).
 
 use super::super::mapping::{OccupancyMap, StateChange};
 use glam::IVec3;

@@ -62,20 +62,16 @@ impl ChunkStore {
     /// clears the record of written chunks.
     pub fn take_state_changes(&mut self) -> Vec<StateChange> {
         let grid = self.grid();
-        let written = std::mem::take(&mut self.written);
         let mut changes = Vec::new();
-        for flat in written {
-            self.written_flags[flat] = false;
+        for coord in self.take_written() {
+            let flat = grid.flat_unchecked(coord);
             let Some((chunk, _)) = &self.chunks[flat] else {
                 continue;
             };
             let seen = self.seen_versions[flat].replace(chunk.state_version());
             let bricks = chunk.state_changed_bricks_since(seen);
             if bricks != 0 {
-                changes.push(StateChange {
-                    coord: grid.coord(flat),
-                    bricks,
-                });
+                changes.push(StateChange { coord, bricks });
             }
         }
         changes

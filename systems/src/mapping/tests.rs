@@ -16,14 +16,15 @@ const OCTOMAP: LogOddsIncrements = LogOddsIncrements {
     miss: -405,
 };
 
-/// Integrates into `store` one scan from `origin` of the rays `(end, hit)`, with the OctoMap
-/// increments: a test of the consumers of the map update (frontiers, traversability).
-pub(crate) fn integrate_rays(
+/// Integrates into `store` one scan from `origin` of the rays `(end, hit)` with the
+/// increments `inc`, adding the change of the statistics to `totals`.
+fn integrate_rays_with(
     store: &mut ChunkStore,
     counter: &mut ScanCounter,
-    origin: Vec3,
-    rays: &[(Vec3, bool)],
-) {
+    totals: &mut StatSums,
+    (origin, rays): (Vec3, &[(Vec3, bool)]),
+    inc: LogOddsIncrements,
+) -> ScanReport {
     let (endpoints, hit): (Vec<Vec3>, Vec<bool>) = rays.iter().copied().unzip();
     let rays = ScanRays {
         origin,
@@ -31,16 +32,19 @@ pub(crate) fn integrate_rays(
         hit: &hit,
     };
     let config = store.config().clone();
+    integrate_scan(&config, counter.next_id(), rays, inc, store, totals).unwrap()
+}
+
+/// [`integrate_rays_with`] the OctoMap increments: a test of the consumers of the map update
+/// (frontiers, traversability).
+pub(crate) fn integrate_rays(
+    store: &mut ChunkStore,
+    counter: &mut ScanCounter,
+    origin: Vec3,
+    rays: &[(Vec3, bool)],
+) {
     let mut totals = StatSums::default();
-    integrate_scan(
-        &config,
-        counter.next_id(),
-        rays,
-        OCTOMAP,
-        store,
-        &mut totals,
-    )
-    .unwrap();
+    integrate_rays_with(store, counter, &mut totals, (origin, rays), OCTOMAP);
 }
 
 /// [`integrate_rays`] with `rays` random rays (directions uniform in a cube, 0.2 to 4 m long,
@@ -101,23 +105,13 @@ impl Mapper {
         rays: &[(Vec3, bool)],
         inc: LogOddsIncrements,
     ) -> ScanReport {
-        let endpoints: Vec<Vec3> = rays.iter().map(|r| r.0).collect();
-        let hit: Vec<bool> = rays.iter().map(|r| r.1).collect();
-        let rays = ScanRays {
-            origin,
-            endpoints: &endpoints,
-            hit: &hit,
-        };
-        let id = self.counter.next_id();
-        integrate_scan(
-            &self.config,
-            id,
-            rays,
-            inc,
+        integrate_rays_with(
             &mut self.store,
+            &mut self.counter,
             &mut self.totals.0,
+            (origin, rays),
+            inc,
         )
-        .unwrap()
     }
 
     fn scan(&mut self, origin: Vec3, rays: &[(Vec3, bool)]) -> ScanReport {

@@ -109,30 +109,63 @@ pub(super) fn cross_faces(
     dt: [i64; 3],
     taken: impl Fn(i64, i64, i64) -> i64,
 ) -> CubeCrossing {
-    let [tx, ty, tz] = t;
-    let [dtx, dty, dtz] = dt;
+    leaving_face(ahead, t, dt).crossing(t, dt, taken)
+}
+
+/// The face a walk leaves its box through (see [`cross_faces`]), before the crossings up to
+/// it are counted: its time alone tells whether the move comes before the walk's end.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct LeavingFace {
+    time: i64,
+    /// All ones for the leaving axis, zero for the others.
+    axis: [i64; 3],
+}
+
+/// The face reached first, at `F = min_a t_a + (ahead_a - 1) dt_a`, ties to x, then y, then z.
+#[inline(always)]
+pub(super) fn leaving_face(ahead: [i64; 3], t: [i64; 3], dt: [i64; 3]) -> LeavingFace {
     let [cx, cy, cz] = dt.map(|dt| dt.min(DT_COMPARE_CAP));
-    let fx = tx + (ahead[0] - 1) * cx;
-    let fy = ty + (ahead[1] - 1) * cy;
-    let fz = tz + (ahead[2] - 1) * cz;
+    let fx = t[0] + (ahead[0] - 1) * cx;
+    let fy = t[1] + (ahead[1] - 1) * cy;
+    let fz = t[2] + (ahead[2] - 1) * cz;
     let x = mask((fx <= fy) & (fx <= fz));
     let y = !x & mask(fy <= fz);
     let z = !x & !y;
-    let face = (x & fx) | (y & fy) | (z & fz);
-    // x wins ties against y and z, y against z: at `face`, those go first.
-    let kx = taken(tx, cx, face + (1 & !x)) + (1 & x);
-    let ky = taken(ty, cy, face + (1 & z)) + (1 & y);
-    let kz = taken(tz, cz, face) + (1 & z);
-    CubeCrossing {
-        crossings: [kx, ky, kz],
-        // Exact for an accepted crossing (an axis slower than the cap then takes at most one);
-        // wrapping, so that a rejected one cannot overflow.
-        boundary_times: [
-            tx.wrapping_add(kx.wrapping_mul(dtx)),
-            ty.wrapping_add(ky.wrapping_mul(dty)),
-            tz.wrapping_add(kz.wrapping_mul(dtz)),
-        ],
-        face_time: face,
+    LeavingFace {
+        time: (x & fx) | (y & fy) | (z & fz),
+        axis: [x, y, z],
+    }
+}
+
+impl LeavingFace {
+    /// The crossings of every axis up to this face, and the boundary times after them.
+    #[inline(always)]
+    fn crossing(
+        self,
+        t: [i64; 3],
+        dt: [i64; 3],
+        taken: impl Fn(i64, i64, i64) -> i64,
+    ) -> CubeCrossing {
+        let [tx, ty, tz] = t;
+        let [dtx, dty, dtz] = dt;
+        let [cx, cy, cz] = dt.map(|dt| dt.min(DT_COMPARE_CAP));
+        let [x, y, z] = self.axis;
+        let face = self.time;
+        // x wins ties against y and z, y against z: at `face`, those go first.
+        let kx = taken(tx, cx, face + (1 & !x)) + (1 & x);
+        let ky = taken(ty, cy, face + (1 & z)) + (1 & y);
+        let kz = taken(tz, cz, face) + (1 & z);
+        CubeCrossing {
+            crossings: [kx, ky, kz],
+            // Exact for an accepted crossing (an axis slower than the cap then takes at most
+            // one); wrapping, so that a rejected one cannot overflow.
+            boundary_times: [
+                tx.wrapping_add(kx.wrapping_mul(dtx)),
+                ty.wrapping_add(ky.wrapping_mul(dty)),
+                tz.wrapping_add(kz.wrapping_mul(dtz)),
+            ],
+            face_time: face,
+        }
     }
 }
 
@@ -180,49 +213,89 @@ impl CubeLimit {
     }
 }
 
-/// The largest saturated cube around the walk's voxel (its brick is full: bit `brick` of
-/// `full_bricks`) that it leaves before `t_safe`: the whole chunk when every brick is full,
-/// else the voxel's 8^3 block when its eight bricks are, else the brick; a larger cube whose
-/// face comes too late gives way to the smaller ones. `None` when even the brick's face does.
-/// Only the cubes `limit` allows are tried, and each one that fails lowers it.
+/// What stays fixed while a walk crosses one chunk: its steps (+1, -1 or 0 per axis) and
+/// boundary intervals (see [`cross_cube`]), the time before which a move must leave its cube
+/// (the segment's safe end), and its end key in the chunk's local coordinates (outside
+/// `0..16` when it ends in another chunk).
+#[derive(Debug, Clone, Copy)]
+pub struct WalkInChunk {
+    pub steps: [i64; 3],
+    pub dt: [i64; 3],
+    pub t_safe: i64,
+    pub end: [i64; 3],
+}
+
+/// What a walk does at a saturated cube around its voxel ([`leave_cube`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CubeMove {
+    /// It leaves the cube in one move, before its end.
+    Cross(Cube, CubeCrossing),
+    /// Its end lies in the cube: every voxel it has left to visit does (a walk keeps within
+    /// the box of its current and end keys, each axis moving one way) and is saturated, where
+    /// a miss changes nothing. The walk is done.
+    EndsInside,
+    /// Neither: it steps on (or tries a smaller cube).
+    Step,
+}
+
+/// The walk, at chunk-local `local` with next boundary times `t`, at the saturated cube of
+/// edge `EDGE` around its voxel (of kind `cube`): the move out of it when its face comes
+/// before `walk.t_safe` (the crossings counted only then); else, the limit lowered, whether
+/// the cube holds the walk's end.
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
+pub fn leave_cube<const EDGE: i64>(
+    cube: Cube,
+    walk: &WalkInChunk,
+    local: [i64; 3],
+    t: [i64; 3],
+    limit: &mut CubeLimit,
+) -> CubeMove {
+    // The face first, the crossings only for a move taken (the same computation as
+    // `cross_cube`'s, shared once inlined): a quarter of the tries fail.
+    let ahead = [0, 1, 2].map(|a| ahead::<EDGE>(local[a], walk.steps[a]));
+    if leaving_face(ahead, t, walk.dt).time < walk.t_safe {
+        return CubeMove::Cross(cube, cross_cube::<EDGE>(local, walk.steps, t, walk.dt));
+    }
+    limit.failed(cube);
+    let shift = EDGE.trailing_zeros();
+    if (0..3).all(|a| local[a] >> shift == walk.end[a] >> shift) {
+        CubeMove::EndsInside
+    } else {
+        CubeMove::Step
+    }
+}
+
+/// The walk at the largest saturated cube around its voxel (its brick is full: bit `brick` of
+/// `full_bricks`; see [`leave_cube`]): the whole chunk when every brick is full, else the
+/// voxel's 8^3 block when its eight bricks are, else the brick; a larger cube whose face comes
+/// too late, and does not hold the end, gives way to the smaller ones. Only the cubes `limit`
+/// allows are tried, and each one that fails lowers it.
+#[inline(always)]
 pub fn cross_saturated(
     full_bricks: u64,
     brick: usize,
+    walk: &WalkInChunk,
     local: [i64; 3],
-    steps: [i64; 3],
     t: [i64; 3],
-    dt: [i64; 3],
-    t_safe: i64,
     limit: &mut CubeLimit,
-) -> Option<(Cube, CubeCrossing)> {
-    // Tries `cube`: the crossing if its face comes in time, else lowers the limit.
-    let leave = |limit: &mut CubeLimit, cube: Cube, crossing: CubeCrossing| {
-        if crossing.face_time < t_safe {
-            Some((cube, crossing))
-        } else {
-            limit.failed(cube);
-            None
-        }
-    };
+) -> CubeMove {
     if limit.allows(Cube::Chunk) && full_bricks == u64::MAX {
-        let crossing = leave(limit, Cube::Chunk, cross_cube::<16>(local, steps, t, dt));
-        if crossing.is_some() {
-            return crossing;
+        let moved = leave_cube::<16>(Cube::Chunk, walk, local, t, limit);
+        if moved != CubeMove::Step {
+            return moved;
         }
     }
     let block = block_bricks(brick);
     if limit.allows(Cube::Block) && full_bricks & block == block {
-        let crossing = leave(limit, Cube::Block, cross_cube::<8>(local, steps, t, dt));
-        if crossing.is_some() {
-            return crossing;
+        let moved = leave_cube::<8>(Cube::Block, walk, local, t, limit);
+        if moved != CubeMove::Step {
+            return moved;
         }
     }
     if limit.allows(Cube::Brick) {
-        return leave(limit, Cube::Brick, cross_cube::<4>(local, steps, t, dt));
+        return leave_cube::<4>(Cube::Brick, walk, local, t, limit);
     }
-    None
+    CubeMove::Step
 }
 
 #[cfg(test)]
@@ -371,6 +444,56 @@ pub(super) mod tests {
             accepted > 100_000,
             "only {accepted} cases crossed before the end"
         );
+    }
+
+    /// A walk along +x from local x = 1 (crossings every 10 from t = 5: the brick's face at
+    /// 25, the block's at 65, the chunk's at 145) in brick 0 of a chunk whose full bricks are
+    /// `full`, ending at local x `end`, whose moves must come before `t_safe`.
+    fn along_x(full: u64, end: i64, t_safe: i64, limit: &mut CubeLimit) -> CubeMove {
+        let walk = WalkInChunk {
+            steps: [1, 0, 0],
+            dt: [10, 0, 0],
+            t_safe,
+            end: [end, 1, 2],
+        };
+        cross_saturated(full, 0, &walk, [1, 1, 2], [5, MAX, MAX], limit)
+    }
+
+    #[test]
+    fn a_walk_ends_inside_the_first_saturated_cube_that_holds_its_end() {
+        let (chunk, block, brick) = (u64::MAX, block_bricks(0), 1);
+        let ends = |full: u64, end: i64, t_safe: i64| {
+            let mut limit = CubeLimit::ANY;
+            (along_x(full, end, t_safe, &mut limit), limit)
+        };
+        // The chunk's face comes too late and the end is in the chunk: done, whatever the
+        // smaller cubes would do.
+        assert_eq!(ends(chunk, 14, 100), (CubeMove::EndsInside, CubeLimit(2)));
+        // The end in the next chunk: the chunk fails, the block's face comes in time.
+        let (CubeMove::Cross(Cube::Block, crossing), CubeLimit(2)) = ends(chunk, 17, 100) else {
+            panic!("expected the block crossed");
+        };
+        assert_eq!((crossing.crossings, crossing.face_time), ([7, 0, 0], 65));
+        // Only the block is saturated (the chunk is not tried): the end in it, or past it.
+        assert_eq!(ends(block, 6, 50), (CubeMove::EndsInside, CubeLimit(1)));
+        let (CubeMove::Cross(Cube::Brick, _), CubeLimit(1)) = ends(block, 9, 50) else {
+            panic!("expected the brick crossed");
+        };
+        assert_eq!(ends(block, 9, 20), (CubeMove::Step, CubeLimit::NONE));
+        // Only the brick: the end in it, or in the next brick.
+        assert_eq!(ends(brick, 3, 20), (CubeMove::EndsInside, CubeLimit::NONE));
+        assert_eq!(ends(brick, 4, 20), (CubeMove::Step, CubeLimit::NONE));
+        // An end in another chunk never lies inside (local -1 below, 16 above; going -x from
+        // local 1, every cube's face comes at 15).
+        let walk_down = WalkInChunk {
+            steps: [-1, 0, 0],
+            dt: [10, 0, 0],
+            t_safe: 10,
+            end: [-1, 1, 2],
+        };
+        let mut limit = CubeLimit::ANY;
+        let moved = cross_saturated(chunk, 0, &walk_down, [1, 1, 2], [5, MAX, MAX], &mut limit);
+        assert_eq!((moved, limit), (CubeMove::Step, CubeLimit::NONE));
     }
 
     #[test]

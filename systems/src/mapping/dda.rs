@@ -199,6 +199,12 @@ impl VoxelWalk {
         self.remaining.iter().map(|&r| u64::from(r)).sum()
     }
 
+    /// The key the walk ends in.
+    #[inline]
+    pub fn last_key(&self) -> IVec3 {
+        IVec3::from_array([0, 1, 2].map(|a| self.key[a] + self.step[a] * self.remaining[a] as i32))
+    }
+
     /// Step (+1, -1 or 0) of the walk along each axis.
     #[inline]
     pub fn steps(&self) -> [i32; 3] {

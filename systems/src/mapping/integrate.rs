@@ -14,7 +14,7 @@
 //! chunks) in one move each ([`cross_saturated`]): a miss changes none of them, so the map is
 //! the same as if each voxel had been visited.
 
-use super::cube::{Cube, CubeLimit, cross_cube, cross_saturated};
+use super::cube::{Cube, CubeLimit, CubeMove, WalkInChunk, cross_saturated, leave_cube};
 use super::dda::{SegmentClipper, T_ONE, VoxelWalk, to_fixed};
 use super::free_box::{FreeBox, FreeBoxes};
 use super::update::{UpdateRule, update_voxel};
@@ -89,6 +89,9 @@ pub struct ScanReport {
     pub skipped_voxels: u64,
     /// Saturated cubes crossed in one move, by size (indexed by [`Cube`]).
     pub cubes_crossed: [u64; 3],
+    /// Walks that ended inside a saturated cube they reached (the rest of the walk skipped:
+    /// [`super::cube::CubeMove::EndsInside`]).
+    pub ends_in_cubes: u64,
     /// Chunks the walks entered or crossed (one per chunk per ray).
     pub chunk_visits: u64,
     /// Voxels in the scan's first free box (`super::free_box`; 0 when it had none).
@@ -379,7 +382,8 @@ impl<C: ChunkAccess> Integration<'_, C> {
     ///   around it (brick, block or chunk) in one move ([`cross_saturated`]), as long as a
     ///   miss cannot change them (a non-positive miss increment) and the cube's face comes
     ///   before `t_safe` (a saturated voxel in a brick that is not full costs one compare:
-    ///   [`update_voxel`]).
+    ///   [`update_voxel`]); a walk whose end lies in such a cube is done there (every voxel
+    ///   left is in it: [`CubeMove::EndsInside`]).
     ///
     /// No lookups, no bounds checks.
     fn walk_fast(
@@ -395,6 +399,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let [mx, my, mz] = walk.steps().map(i64::from);
         let [cx, cy, cz] = [mx * CURSOR_X, my * CURSOR_Y, mz * CURSOR_Z];
         let mut key = walk.key();
+        let last_key = walk.last_key();
         let mut stop = false;
         // Saturated voxels stay unchanged by a non-positive increment only (a miss, always in
         // practice).
@@ -408,28 +413,42 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let flat = self.grid.flat_unchecked(coord);
             let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
             self.report.chunk_visits += 1;
+            let in_chunk = WalkInChunk {
+                steps: [mx, my, mz],
+                dt: [dtx, dty, dtz],
+                t_safe,
+                end: (last_key - coord.first_key()).as_i64vec3().to_array(),
+            };
             // A chunk saturated whole is crossed without entering it: no voxel, stamp or
             // statistic of it is touched (the same move as `cross_saturated`'s chunk case).
             if cubes_left.allows(Cube::Chunk) && chunk.saturation().full_bricks() == u64::MAX {
                 let local = (key & (CHUNK_EDGE - 1)).as_i64vec3().to_array();
-                let crossing = cross_cube::<{ CHUNK_EDGE as i64 }>(
+                match leave_cube::<{ CHUNK_EDGE as i64 }>(
+                    Cube::Chunk,
+                    &in_chunk,
                     local,
-                    [mx, my, mz],
                     [tx, ty, tz],
-                    [dtx, dty, dtz],
-                );
-                if crossing.face_time < t_safe {
-                    let passed = crossing.voxels_passed() as u64;
-                    debug_assert!(passed <= visits);
-                    visits -= passed;
-                    self.report.skipped_voxels += passed;
-                    self.report.cubes_crossed[Cube::Chunk as usize] += 1;
-                    [tx, ty, tz] = crossing.boundary_times;
-                    let [kx, ky, kz] = crossing.crossings;
-                    key += IVec3::new((kx * mx) as i32, (ky * my) as i32, (kz * mz) as i32);
-                    continue;
+                    &mut cubes_left,
+                ) {
+                    CubeMove::Cross(_, crossing) => {
+                        let passed = crossing.voxels_passed() as u64;
+                        debug_assert!(passed <= visits);
+                        visits -= passed;
+                        self.report.skipped_voxels += passed;
+                        self.report.cubes_crossed[Cube::Chunk as usize] += 1;
+                        [tx, ty, tz] = crossing.boundary_times;
+                        let [kx, ky, kz] = crossing.crossings;
+                        key += IVec3::new((kx * mx) as i32, (ky * my) as i32, (kz * mz) as i32);
+                        continue;
+                    }
+                    CubeMove::EndsInside => {
+                        self.report.skipped_voxels += visits;
+                        self.report.ends_in_cubes += 1;
+                        visits = 0;
+                        break;
+                    }
+                    CubeMove::Step => {}
                 }
-                cubes_left.failed(Cube::Chunk);
             }
             chunk.begin_scan(self.scan);
             let before = *stats;
@@ -438,6 +457,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             let mut changed = 0u64;
             let mut skipped = 0u64;
             let mut cubes = [0u64; 3];
+            let mut ends_in_cubes = 0u64;
             // The bricks where a voxel's state changed (`VoxelChunk::note_state_changes_in`).
             let mut state_bricks = 0u64;
             loop {
@@ -445,37 +465,44 @@ impl<C: ChunkAccess> Integration<'_, C> {
                 let brick = brick_of(index);
                 let full_bricks = saturation.full_bricks();
                 if cubes_left.open() && full_bricks >> brick & 1 == 1 {
-                    let crossing = cross_saturated(
+                    match cross_saturated(
                         full_bricks,
                         brick,
+                        &in_chunk,
                         cursor.local_array(),
-                        [mx, my, mz],
                         [tx, ty, tz],
-                        [dtx, dty, dtz],
-                        t_safe,
                         &mut cubes_left,
-                    );
-                    if let Some((cube, crossing)) = crossing {
-                        cubes[cube as usize] += 1;
-                        // Every crossing is before `t_safe`, hence before the segment's end:
-                        // the voxels passed are on the walk, and the one entered is too,
-                        // unless it is the excluded end voxel of a hit (then no visit is left).
-                        let passed = crossing.voxels_passed() as u64;
-                        debug_assert!(passed <= visits);
-                        visits -= passed;
-                        skipped += passed;
-                        [tx, ty, tz] = crossing.boundary_times;
-                        let [kx, ky, kz] = crossing.crossings;
-                        cursor.0 = cursor.0.wrapping_add(
-                            kx.wrapping_mul(cx)
-                                .wrapping_add(ky.wrapping_mul(cy))
-                                .wrapping_add(kz.wrapping_mul(cz))
-                                as u64,
-                        );
-                        if visits == 0 || cursor.left_chunk() {
+                    ) {
+                        CubeMove::Cross(cube, crossing) => {
+                            cubes[cube as usize] += 1;
+                            // Every crossing is before `t_safe`, hence before the segment's
+                            // end: the voxels passed are on the walk, and the one entered is
+                            // too, unless it is the excluded end voxel of a hit (then no visit
+                            // is left).
+                            let passed = crossing.voxels_passed() as u64;
+                            debug_assert!(passed <= visits);
+                            visits -= passed;
+                            skipped += passed;
+                            [tx, ty, tz] = crossing.boundary_times;
+                            let [kx, ky, kz] = crossing.crossings;
+                            cursor.0 = cursor.0.wrapping_add(
+                                kx.wrapping_mul(cx)
+                                    .wrapping_add(ky.wrapping_mul(cy))
+                                    .wrapping_add(kz.wrapping_mul(cz))
+                                    as u64,
+                            );
+                            if visits == 0 || cursor.left_chunk() {
+                                break;
+                            }
+                            continue;
+                        }
+                        CubeMove::EndsInside => {
+                            skipped += visits;
+                            ends_in_cubes += 1;
+                            visits = 0;
                             break;
                         }
-                        continue;
+                        CubeMove::Step => {}
                     }
                 }
                 let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
@@ -504,6 +531,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             }
             key = coord.first_key() + cursor.local();
             self.report.skipped_voxels += skipped;
+            self.report.ends_in_cubes += ends_in_cubes;
             for (total, crossed) in self.report.cubes_crossed.iter_mut().zip(cubes) {
                 *total += crossed;
             }

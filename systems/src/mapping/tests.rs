@@ -505,6 +505,32 @@ fn a_scan_updates_exactly_the_traversed_voxels() {
     }
 }
 
+/// A walk that cannot leave its saturated brick before its end, yet ends past the brick's face
+/// (within the end margin, where rounding is left to the counted walk), still updates its end
+/// voxel: only a walk whose end lies inside the cube is cut short
+/// (`super::cube::CubeMove::EndsInside`).
+#[test]
+fn a_walk_ending_just_past_a_saturated_brick_updates_its_end_voxel() {
+    let mut m = Mapper::new();
+    // Saturate bricks (0, 0, 0) and (1, 0, 0): keys x 0..8, y and z 0..4, a max-range ray to
+    // each voxel's centre, six times (five misses reach the lower bound).
+    let origin = Vec3::splat(0.15);
+    let centres: Vec<(Vec3, bool)> = (0..8)
+        .flat_map(|x| (0..4).flat_map(move |y| (0..4).map(move |z| IVec3::new(x, y, z))))
+        .map(|k| ((k.as_vec3() + 0.5) * 0.1, false))
+        .collect();
+    for _ in 0..6 {
+        m.scan(origin, &centres);
+    }
+    assert_eq!(m.l(7, 3, 3), Some(-1992));
+    assert_eq!(m.l(8, 1, 1), None);
+    // A ray along x ending one f32 step past x = 0.8 m, the face to key 8 (unknown): the face
+    // comes within 1e-6 of the segment's end.
+    let end = Vec3::new(f32::from_bits(0.8_f32.to_bits() + 1), 0.15, 0.15);
+    m.scan(origin, &[(end, false)]);
+    assert_eq!(m.l(8, 1, 1), Some(-405));
+}
+
 fn floor_key(q: DVec3) -> IVec3 {
     q.floor().as_ivec3()
 }
@@ -547,7 +573,7 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         miss: -847,
     };
     let (mut visits, mut skipped, mut cubes) = (0, 0, [0; 3]);
-    let (mut box_rays, mut box_exits) = (0, 0);
+    let (mut box_rays, mut box_exits, mut ends_in_cubes) = (0, 0, 0);
     for scan in 0..310 {
         let rays: Vec<(Vec3, bool)>;
         let origin;
@@ -585,6 +611,7 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         skipped += report.skipped_voxels;
         box_rays += report.free_box_rays;
         box_exits += report.free_box_exits;
+        ends_in_cubes += report.ends_in_cubes;
         for (total, crossed) in cubes.iter_mut().zip(report.cubes_crossed) {
             *total += crossed;
         }
@@ -639,6 +666,8 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
     );
     // Every size of cube was crossed: bricks, blocks and whole chunks.
     assert!(cubes.iter().all(|&n| n > 0), "cubes crossed {cubes:?}");
+    // Walks ended inside saturated cubes, the rest of their visits skipped.
+    assert!(ends_in_cubes > 0, "no walk ended inside a saturated cube");
     // And scans from inside the saturated chunk had a free box: rays ended in it, others left
     // it in one move.
     assert!(

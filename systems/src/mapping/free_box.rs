@@ -156,6 +156,13 @@ impl FreeBoxes {
     pub fn iter(&self) -> impl Iterator<Item = &FreeBox> {
         self.0.iter().flatten()
     }
+
+    /// Whether one box holds both keys: then so does every key of a walk between them (a box
+    /// is convex, and each axis of a walk moves one way), and the walk changes nothing.
+    #[inline]
+    pub fn hold(&self, start: IVec3, end: IVec3) -> bool {
+        self.iter().any(|b| b.contains(start) && b.contains(end))
+    }
 }
 
 /// Whether every brick of `from..=to` is full.

@@ -4,10 +4,12 @@
 //! (`super::sweep`), and most of that box around a camera lies outside its field of view: the
 //! wall behind it, the pillar beside it. Four planes through the sensor's origin that every ray
 //! lies behind bound where any ray can go; an obstacle whose bounding box lies wholly in front
-//! of one of them cannot be hit by any ray of the sweep and is not tried.
+//! of one of them cannot be hit by any ray of the sweep and is not tried. The same holds for
+//! each tile of 8 x 8 rays ([`RayTile`]) and the narrower pyramid it lies in.
 
 use glam::{Quat, Vec3};
 use parry3d::bounding_volume::Aabb;
+use std::ops::Range;
 
 /// Margin in slope (tangent) by which the planes stand off the outermost rays: far above the
 /// rounding of a direction turned into the world frame (1e-7), so that every ray lies strictly
@@ -74,6 +76,56 @@ impl Frustum {
             let nearest = (*n * lo).min(*n * hi);
             nearest.x + nearest.y + nearest.z > BOX_MARGIN
         })
+    }
+}
+
+/// Rows and columns of rays in one [`RayTile`] (fewer at the image's right and bottom edges).
+pub const TILE_EDGE: usize = 8;
+
+/// A block of a camera pattern's rays (row-major, `columns` per row) and the pyramid they lie
+/// in. A sweep tries, for a tile's rays, only the obstacles its pyramid does not exclude: the
+/// ground for the tiles that look up, a pillar for the tiles beside it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RayTile {
+    pub rows: Range<usize>,
+    pub columns: Range<usize>,
+    pub frustum: Frustum,
+}
+
+impl RayTile {
+    /// The pattern's rays in tiles of [`TILE_EDGE`]^2, covering each ray once; none when some
+    /// tile has no enclosing pyramid (rays that do not all look forward).
+    pub fn tile(directions: &[Vec3], columns: usize, rows: usize) -> Vec<Self> {
+        if columns * rows != directions.len() {
+            return Vec::new();
+        }
+        let starts = |n: usize| {
+            (0..n)
+                .step_by(TILE_EDGE)
+                .map(move |s| s..(s + TILE_EDGE).min(n))
+        };
+        let mut tiles = Vec::new();
+        for tile_rows in starts(rows) {
+            for tile_columns in starts(columns) {
+                let rays: Vec<Vec3> = tile_rows
+                    .clone()
+                    .flat_map(|r| {
+                        directions[r * columns..][tile_columns.clone()]
+                            .iter()
+                            .copied()
+                    })
+                    .collect();
+                let Some(frustum) = Frustum::enclosing(&rays) else {
+                    return Vec::new();
+                };
+                tiles.push(Self {
+                    rows: tile_rows.clone(),
+                    columns: tile_columns,
+                    frustum,
+                });
+            }
+        }
+        tiles
     }
 }
 
@@ -150,6 +202,47 @@ mod tests {
         let corner = pattern.directions[0];
         let past = corner + Vec3::new(0.0, 2.5e-3 * corner.x, 0.0);
         assert!(frustum.normals.iter().any(|n| n.dot(past) > 0.0));
+    }
+
+    /// The thesis camera's `auto` rays (55 x 41) fall in 7 x 6 tiles, each ray in exactly one,
+    /// strictly behind every plane of its tile; a tile's pyramid is narrower than the
+    /// camera's.
+    #[test]
+    fn tiles_cover_every_ray_once_each_inside_its_pyramid() {
+        use crate::sensing::{PinholeCamera, RayGrid, camera_pattern};
+        let camera = PinholeCamera {
+            width: 640,
+            height: 480,
+            hfov: 1.0,
+        };
+        let pattern =
+            camera_pattern(camera, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).expect("pattern");
+        let columns = pattern.columns as usize;
+        assert_eq!((columns, pattern.rows), (55, 41));
+        assert_eq!(pattern.tiles.len(), 7 * 6);
+        let mut covered = vec![0; pattern.directions.len()];
+        for tile in &pattern.tiles {
+            for row in tile.rows.clone() {
+                for column in tile.columns.clone() {
+                    let i = row * columns + column;
+                    covered[i] += 1;
+                    let d = pattern.directions[i];
+                    assert!(
+                        tile.frustum.normals.iter().all(|n| n.dot(d) < 0.0),
+                        "ray {i}"
+                    );
+                }
+            }
+        }
+        assert!(covered.iter().all(|&n| n == 1));
+        // The middle tile excludes a box the whole camera sees (left of the middle).
+        let middle = &pattern.tiles[2 * 7 + 3];
+        let left = Aabb::new(Vec3::new(4.0, 1.0, -0.2), Vec3::new(4.5, 1.5, 0.2));
+        assert!(middle.frustum.excludes(Vec3::ZERO, &left));
+        assert!(!pattern.frustum.unwrap().excludes(Vec3::ZERO, &left));
+        // Rays that do not fill the grid, or look back, have no tiles.
+        assert!(RayTile::tile(&pattern.directions, columns + 1, 41).is_empty());
+        assert!(RayTile::tile(&[Vec3::X, Vec3::NEG_X], 2, 1).is_empty());
     }
 
     #[test]

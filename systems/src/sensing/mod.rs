@@ -11,7 +11,7 @@ mod frustum;
 mod pattern;
 mod sweep;
 
-pub use frustum::Frustum;
+pub use frustum::{Frustum, RayTile};
 
 pub use pattern::{
     LidarBeams, MAX_RAYS, PatternError, PinholeCamera, RayGrid, RayPattern, auto_grid,

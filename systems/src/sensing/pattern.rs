@@ -4,7 +4,7 @@
 //! camera's own resolution gives one ray per pixel, the `auto` grid the coarsest grid that still
 //! sees every voxel of the map (common.md §2). A lidar casts beams at even angular steps.
 
-use super::frustum::Frustum;
+use super::frustum::{Frustum, RayTile};
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -28,6 +28,9 @@ pub struct RayPattern {
     /// The pyramid the directions lie in, when they all look forward (a camera's): obstacles
     /// outside it are not tried ([`Frustum`]).
     pub frustum: Option<Frustum>,
+    /// The rays in tiles, each with its own pyramid ([`RayTile`]); empty when there is no
+    /// frustum.
+    pub tiles: Vec<RayTile>,
 }
 
 /// A pinhole depth camera (common.md §2): looks along +x, square pixels, so the vertical field
@@ -165,6 +168,7 @@ pub fn camera_pattern(
     }
     Ok(RayPattern {
         frustum: Frustum::enclosing(&directions),
+        tiles: RayTile::tile(&directions, columns as usize, rows as usize),
         directions,
         columns,
         rows,
@@ -312,6 +316,7 @@ pub fn lidar_pattern(
     }
     Ok(RayPattern {
         frustum: Frustum::enclosing(&directions),
+        tiles: RayTile::tile(&directions, lidar.beams_h as usize, lidar.beams_v as usize),
         directions,
         columns: lidar.beams_h,
         rows: lidar.beams_v,

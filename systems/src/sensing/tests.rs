@@ -345,6 +345,7 @@ fn range_noise_is_gaussian_and_reproducible_per_stream() {
         range_min: 0.5,
         range_max: 10.0,
         frustum: None,
+        tiles: Vec::new(),
     };
     let world = WorldGeometry::new(vec![wall(Vec3::new(4.5, 0.0, 0.0), Vec3::ONE)]).unwrap();
     let pose = SensorPose {

@@ -175,18 +175,22 @@ mod tests {
         assert!(back.excludes(Vec3::ZERO, &cube(Vec3::new(3.0, 0.0, 0.0))));
     }
 
-    /// The thesis camera's `auto` rays all lie strictly behind every plane, however the camera
-    /// is turned, and a direction just past the corner ray (by 2.5e-3 in slope) does not.
-    #[test]
-    fn every_ray_lies_behind_every_plane_and_the_planes_are_tight() {
+    /// The thesis camera's `auto` pattern (640 x 480 px, 1.0 rad, 0.5-5 m, 0.1 m map).
+    fn thesis_camera() -> crate::sensing::RayPattern {
         use crate::sensing::{PinholeCamera, RayGrid, camera_pattern};
         let camera = PinholeCamera {
             width: 640,
             height: 480,
             hfov: 1.0,
         };
-        let pattern =
-            camera_pattern(camera, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).expect("pattern");
+        camera_pattern(camera, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).expect("pattern")
+    }
+
+    /// The thesis camera's `auto` rays all lie strictly behind every plane, however the camera
+    /// is turned, and a direction just past the corner ray (by 2.5e-3 in slope) does not.
+    #[test]
+    fn every_ray_lies_behind_every_plane_and_the_planes_are_tight() {
+        let pattern = thesis_camera();
         let frustum = pattern.frustum.expect("a camera's frustum");
         for rotation in [
             Quat::IDENTITY,
@@ -209,14 +213,7 @@ mod tests {
     /// camera's.
     #[test]
     fn tiles_cover_every_ray_once_each_inside_its_pyramid() {
-        use crate::sensing::{PinholeCamera, RayGrid, camera_pattern};
-        let camera = PinholeCamera {
-            width: 640,
-            height: 480,
-            hfov: 1.0,
-        };
-        let pattern =
-            camera_pattern(camera, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).expect("pattern");
+        let pattern = thesis_camera();
         let columns = pattern.columns as usize;
         assert_eq!((columns, pattern.rows), (55, 41));
         assert_eq!(pattern.tiles.len(), 7 * 6);

@@ -250,8 +250,8 @@ pub fn leave_cube<const EDGE: i64>(
     t: [i64; 3],
     limit: &mut CubeLimit,
 ) -> CubeMove {
-    // The face first, the crossings only for a move taken (the same computation as
-    // `cross_cube`'s, shared once inlined): a quarter of the tries fail.
+    // The face first, the crossings only for a move taken: a quarter of the tries fail.
+    // (`cross_cube` finds the face again; handing it this one made the mission 1 % slower.)
     let ahead = [0, 1, 2].map(|a| ahead::<EDGE>(local[a], walk.steps[a]));
     if leaving_face(ahead, t, walk.dt).time < walk.t_safe {
         return CubeMove::Cross(cube, cross_cube::<EDGE>(local, walk.steps, t, walk.dt));

@@ -4,6 +4,7 @@
 //! - [`dda`]: Amanatides & Woo voxel traversal, clipped to the map.
 //! - [`update`]: the log-odds update of one voxel (stamp, add, clamp, statistics).
 //! - [`cube`]: walking past a cube (brick, block, chunk) of saturated free voxels in one move.
+//! - `cursor`: the walk's position inside a chunk, index and coordinates in one integer.
 //! - [`free_box`]: the box of saturated free bricks around a scan's sensor, which every ray
 //!   leaves in one move.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
@@ -18,6 +19,7 @@
 //! Commands: systems that read the map later in the same tick must run after a command flush.
 
 pub mod cube;
+mod cursor;
 pub mod dda;
 pub mod free_box;
 pub mod integrate;

@@ -7,6 +7,7 @@
 //! here rather than in `uavex-components` because nothing but this stage reads them; the data
 //! other stages share (`Scan`, `Mount`, `SensorQuality`) stays in `components::sensor`.
 
+mod box_cast;
 mod frustum;
 mod pattern;
 mod sweep;

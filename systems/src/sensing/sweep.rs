@@ -2,12 +2,12 @@
 //! endpoints and hit flags of a [`Scan`] (common.md §1-2).
 
 use super::RayPattern;
+use super::box_cast::LocalBox;
 use super::frustum::{Frustum, RayTile};
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec3, Vec3A};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
-use parry3d::query::{Ray, RayCast};
-use parry3d::shape::Cuboid;
+use parry3d::query::Ray;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
@@ -186,14 +186,15 @@ struct NearObstacle {
     /// it can come nearer (0 from inside the box).
     nearest: f32,
     /// The sensor origin in the obstacle's frame (`pose.inverse_transform_point(origin)`).
-    local_origin: Vec3,
+    local_origin: Vec3A,
     /// Rotation from the world frame to the obstacle's frame (`pose.rotation.inverse()`).
     to_local: Quat,
     /// Its bounding box (world frame).
     aabb: Aabb,
-    /// The shape when it is a box (most obstacles are): its own ray test is called directly,
-    /// not through the shape's table of methods, so that it inlines into the ray loop.
-    cuboid: Option<Cuboid>,
+    /// The shape when it is a box (most obstacles are): its ray test is parry's written out
+    /// without branches (`super::box_cast`), inlined into the ray loop; other shapes are
+    /// cast through their table of methods.
+    cuboid: Option<LocalBox>,
 }
 
 /// The obstacles near a sweep, and those of them a tile's pyramid does not exclude (buffers
@@ -270,10 +271,10 @@ fn cast_sweep(
             near.all.push(NearObstacle {
                 index,
                 nearest: gap.length() * (1.0 - NEAREST_MARGIN) - NEAREST_MARGIN,
-                local_origin: obstacle.pose.inverse_transform_point(origin),
+                local_origin: obstacle.pose.inverse_transform_point(origin).into(),
                 to_local: obstacle.pose.rotation.inverse(),
                 aabb,
-                cuboid: obstacle.shape.as_cuboid().copied(),
+                cuboid: obstacle.shape.as_cuboid().map(LocalBox::of),
             });
         }
     }
@@ -289,10 +290,15 @@ fn cast_sweep(
             if n.nearest > best {
                 break;
             }
-            let ray = Ray::new(n.local_origin, n.to_local * dir);
+            // `Quat * Vec3` is this rotation too, with the conversions around it.
+            let local_dir = n.to_local.mul_vec3a(dir.into());
             let toi = match &n.cuboid {
-                Some(cuboid) => cuboid.cast_local_ray(&ray, best, true),
-                None => obstacles[n.index].shape.cast_local_ray(&ray, best, true),
+                Some(local_box) => local_box.cast(n.local_origin, local_dir, best),
+                None => obstacles[n.index].shape.cast_local_ray(
+                    &Ray::new(n.local_origin.into(), local_dir.into()),
+                    best,
+                    true,
+                ),
             };
             if let Some(toi) = toi
                 && toi < best

@@ -165,6 +165,20 @@ impl VoxelWalk {
     /// A walk over the keys of a clipped segment (`start`, `end` are the unclipped points that
     /// parametrise it; the keys need not be the keys of those points).
     pub fn new(start: DVec3, end: DVec3, start_key: IVec3, end_key: IVec3) -> Self {
+        Self::with_inverse(start, end, DVec3::ONE / (end - start), start_key, end_key)
+    }
+
+    /// [`Self::new`] given `inverse = 1 / (end - start)` per axis, computed ahead (the map
+    /// update divides for all of a scan's rays in one pass, where the divisions overlap,
+    /// rather than one ray at a time between walks).
+    #[inline]
+    pub fn with_inverse(
+        start: DVec3,
+        end: DVec3,
+        inverse: DVec3,
+        start_key: IVec3,
+        end_key: IVec3,
+    ) -> Self {
         let d = end - start;
         let mut walk = Self {
             key: start_key.to_array(),
@@ -181,7 +195,7 @@ impl VoxelWalk {
             let boundary = f64::from(start_key[axis] + i32::from(n > 0));
             walk.step[axis] = n.signum();
             walk.remaining[axis] = n.unsigned_abs();
-            let inverse = 1.0 / d[axis];
+            let inverse = inverse[axis];
             walk.t_max[axis] = to_fixed((boundary - start[axis]) * inverse);
             walk.t_delta[axis] = to_fixed(inverse.abs());
         }

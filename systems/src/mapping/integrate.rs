@@ -16,7 +16,7 @@
 
 use super::cube::{Cube, CubeLimit, CubeMove, WalkInChunk, cross_saturated, leave_cube};
 use super::cursor::{CURSOR_X, CURSOR_Y, CURSOR_Z, Cursor};
-use super::dda::{SegmentClipper, T_ONE, VoxelWalk, to_fixed};
+use super::dda::{ClippedSegment, SegmentClipper, T_ONE, VoxelWalk, to_fixed};
 use super::free_box::{FreeBox, FreeBoxes};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3, Vec3};
@@ -68,10 +68,22 @@ impl<'a> ScanRays<'a> {
     }
 }
 
+/// What integrating a scan computes for every ray before it walks any, kept on each thread
+/// from one scan to the next so that integrating a scan allocates nothing.
+#[derive(Default)]
+struct RayScratch {
+    /// The end points in voxel units (hits nudged, see [`end_point`]).
+    ends: Vec<DVec3>,
+    /// `1 / (end - origin)` per axis, for [`VoxelWalk::with_inverse`]: divided in one pass,
+    /// where the divisions of successive rays overlap, instead of between two walks (2-3 %
+    /// off the map update).
+    inverses: Vec<DVec3>,
+    /// Each ray clipped to the map ([`SegmentClipper::clip`]), in one pass too (1 % off).
+    clips: Vec<Option<ClippedSegment>>,
+}
+
 thread_local! {
-    /// The rays' end points in voxel units (hits nudged, see [`end_point`]), kept on each
-    /// thread from one scan to the next so that integrating a scan allocates nothing.
-    static ENDS: RefCell<Vec<DVec3>> = const { RefCell::new(Vec::new()) };
+    static RAYS: RefCell<RayScratch> = RefCell::new(RayScratch::default());
 }
 
 /// What one integration did.
@@ -140,7 +152,12 @@ pub fn integrate_scan(
         },
     };
     let origin = config.to_voxel_units(rays.origin);
-    ENDS.with_borrow_mut(|ends| {
+    RAYS.with_borrow_mut(|scratch| {
+        let RayScratch {
+            ends,
+            inverses,
+            clips,
+        } = scratch;
         // Both passes read every hit's end: computed once (a square root and a division each).
         ends.clear();
         ends.extend(
@@ -149,6 +166,8 @@ pub fn integrate_scan(
                 .zip(rays.hit)
                 .map(|(&p, &hit)| end_point(origin, config.to_voxel_units(p), hit)),
         );
+        inverses.clear();
+        inverses.extend(ends.iter().map(|&end| DVec3::ONE / (end - origin)));
 
         // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
         let hit_rule = rule(increments.hit);
@@ -170,8 +189,11 @@ pub fn integrate_scan(
             FreeBoxes::default()
         };
         let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
-        for (&end, &hit) in ends.iter().zip(rays.hit) {
-            let Some(clip) = clipper.clip(end) else {
+        clips.clear();
+        clips.extend(ends.iter().map(|&end| clipper.clip(end)));
+        let prepared = ends.iter().zip(inverses.iter()).zip(clips.iter());
+        for (((&end, &inverse), &clip), &hit) in prepared.zip(rays.hit) {
+            let Some(clip) = clip else {
                 continue;
             };
             let exclude_end = hit && clip.end_inside;
@@ -185,7 +207,8 @@ pub fn integrate_scan(
                 run.report.free_box_rays += 1;
                 continue;
             }
-            let mut walk = VoxelWalk::new(origin, end, clip.start_key, clip.end_key);
+            let mut walk =
+                VoxelWalk::with_inverse(origin, end, inverse, clip.start_key, clip.end_key);
             let visits = walk.steps_left() + 1 - u64::from(exclude_end);
             run.report.voxel_visits += visits;
             let t_safe = clip.t_end - end_margin(&walk);

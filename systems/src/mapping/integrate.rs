@@ -16,20 +16,16 @@
 
 use super::cube::{Cube, CubeLimit, CubeMove, WalkInChunk, cross_saturated, leave_cube};
 use super::cursor::{CURSOR_X, CURSOR_Y, CURSOR_Z, Cursor};
-use super::dda::{ClippedSegment, SegmentClipper, T_ONE, VoxelWalk, to_fixed};
+use super::dda::{T_ONE, VoxelWalk, to_fixed};
 use super::free_box::{FreeBox, FreeBoxes};
+pub use super::rays::{HIT_NUDGE, ScanError, ScanRays};
+use super::rays::{PreparedRays, prepare};
 use super::update::{UpdateRule, update_voxel};
-use glam::{DVec3, IVec3, Vec3};
-use std::cell::RefCell;
+use glam::{DVec3, IVec3};
 use uavex_components::map::{
     BRICK_EDGE, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig,
     ScanId, StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
 };
-use uavex_components::sensor::Scan;
-
-/// How far past a surface a hit point is moved along its ray (voxel units), so that a hit
-/// exactly on a voxel face lands in the obstacle's voxel, not the free one in front of it.
-pub const HIT_NUDGE: f64 = 1e-3;
 
 /// Mutable access to the map's chunks, by flat chunk index (see [`ChunkGrid::flat`]).
 pub trait ChunkAccess {
@@ -47,43 +43,6 @@ pub trait ChunkAccess {
     ///
     /// [`BrickSaturation::full_bricks`]: uavex_components::map::BrickSaturation::full_bricks
     fn full_bricks(&self, flat: usize) -> u64;
-}
-
-/// The rays of one scan, in the world frame (see [`Scan`]).
-#[derive(Debug, Clone, Copy)]
-pub struct ScanRays<'a> {
-    pub origin: Vec3,
-    pub endpoints: &'a [Vec3],
-    /// Whether ray `i` ended on a surface (else it was cut at max range).
-    pub hit: &'a [bool],
-}
-
-impl<'a> ScanRays<'a> {
-    pub fn of(scan: &'a Scan) -> Self {
-        Self {
-            origin: scan.origin,
-            endpoints: &scan.endpoints,
-            hit: &scan.hit,
-        }
-    }
-}
-
-/// What integrating a scan computes for every ray before it walks any, kept on each thread
-/// from one scan to the next so that integrating a scan allocates nothing.
-#[derive(Default)]
-struct RayScratch {
-    /// The end points in voxel units (hits nudged, see [`end_point`]).
-    ends: Vec<DVec3>,
-    /// `1 / (end - origin)` per axis, for [`VoxelWalk::with_inverse`]: divided in one pass,
-    /// where the divisions of successive rays overlap, instead of between two walks (2-3 %
-    /// off the map update).
-    inverses: Vec<DVec3>,
-    /// Each ray clipped to the map ([`SegmentClipper::clip`]), in one pass too (1 % off).
-    clips: Vec<Option<ClippedSegment>>,
-}
-
-thread_local! {
-    static RAYS: RefCell<RayScratch> = RefCell::new(RayScratch::default());
 }
 
 /// What one integration did.
@@ -112,17 +71,6 @@ pub struct ScanReport {
     pub free_box_exits: u64,
 }
 
-/// A scan that cannot be integrated (refused before anything is written).
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-pub enum ScanError {
-    #[error("scan has {endpoints} endpoints but {hits} hit flags")]
-    LengthMismatch { endpoints: usize, hits: usize },
-    #[error("scan origin is not finite: {0}")]
-    NonFiniteOrigin(Vec3),
-    #[error("scan endpoint {index} is not finite: {point}")]
-    NonFiniteEndpoint { index: usize, point: Vec3 },
-}
-
 /// Integrates one scan (common.md §1): see the module documentation. `totals` receives the
 /// change of every chunk's statistics (the map-wide [`uavex_components::map::MapTotals`]).
 pub fn integrate_scan(
@@ -133,7 +81,7 @@ pub fn integrate_scan(
     chunks: &mut impl ChunkAccess,
     totals: &mut StatSums,
 ) -> Result<ScanReport, ScanError> {
-    validate(&rays)?;
+    rays.validate()?;
     let rule = |delta: i16| UpdateRule {
         stamp: scan.stamp(),
         delta: i32::from(delta),
@@ -151,24 +99,13 @@ pub fn integrate_scan(
             ..ScanReport::default()
         },
     };
-    let origin = config.to_voxel_units(rays.origin);
-    RAYS.with_borrow_mut(|scratch| {
-        let RayScratch {
+    prepare(config, &rays, |prepared| {
+        let PreparedRays {
+            origin,
             ends,
             inverses,
             clips,
-        } = scratch;
-        // Both passes read every hit's end: computed once (a square root and a division each).
-        ends.clear();
-        ends.extend(
-            rays.endpoints
-                .iter()
-                .zip(rays.hit)
-                .map(|(&p, &hit)| end_point(origin, config.to_voxel_units(p), hit)),
-        );
-        inverses.clear();
-        inverses.extend(ends.iter().map(|&end| DVec3::ONE / (end - origin)));
-
+        } = prepared;
         // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
         let hit_rule = rule(increments.hit);
         for (&end, _) in ends.iter().zip(rays.hit).filter(|&(_, &hit)| hit) {
@@ -188,9 +125,6 @@ pub fn integrate_scan(
         } else {
             FreeBoxes::default()
         };
-        let clipper = SegmentClipper::new(origin, config.key_min(), config.key_max());
-        clips.clear();
-        clips.extend(ends.iter().map(|&end| clipper.clip(end)));
         let prepared = ends.iter().zip(inverses.iter()).zip(clips.iter());
         for (((&end, &inverse), &clip), &hit) in prepared.zip(rays.hit) {
             let Some(clip) = clip else {
@@ -221,37 +155,6 @@ pub fn integrate_scan(
         }
     });
     Ok(run.report)
-}
-
-/// Where a ray's end voxel is looked up: a hit point is nudged [`HIT_NUDGE`] along the ray.
-#[inline]
-fn end_point(origin: DVec3, end: DVec3, hit: bool) -> DVec3 {
-    let d = end - origin;
-    let length = d.length();
-    if hit && length > 0.0 {
-        end + d * (HIT_NUDGE / length)
-    } else {
-        end
-    }
-}
-
-fn validate(rays: &ScanRays<'_>) -> Result<(), ScanError> {
-    if rays.endpoints.len() != rays.hit.len() {
-        return Err(ScanError::LengthMismatch {
-            endpoints: rays.endpoints.len(),
-            hits: rays.hit.len(),
-        });
-    }
-    if !rays.origin.is_finite() {
-        return Err(ScanError::NonFiniteOrigin(rays.origin));
-    }
-    match rays.endpoints.iter().position(|p| !p.is_finite()) {
-        Some(index) => Err(ScanError::NonFiniteEndpoint {
-            index,
-            point: rays.endpoints[index],
-        }),
-        None => Ok(()),
-    }
 }
 
 /// The state of one scan's integration.

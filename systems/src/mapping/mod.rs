@@ -7,6 +7,7 @@
 //! - `cursor`: the walk's position inside a chunk, index and coordinates in one integer.
 //! - [`free_box`]: the box of saturated free bricks around a scan's sensor, which every ray
 //!   leaves in one move.
+//! - `rays`: a scan's rays checked, in voxel units, and prepared for the walks.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
 //! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
@@ -23,6 +24,7 @@ mod cursor;
 pub mod dda;
 pub mod free_box;
 pub mod integrate;
+mod rays;
 pub mod read;
 pub mod state_changes;
 pub mod store;

@@ -133,14 +133,15 @@ pub fn integrate_scans(
 /// most [`HIT_NUDGE`]), clipped to the map: every voxel the scan can touch lies inside, since
 /// each ray's clipped segment lies inside the box of its two ends.
 fn chunk_box(config: &MapConfig, scan: &Scan) -> Option<(IVec3, IVec3)> {
-    let origin = config.to_voxel_units(scan.origin);
+    // The box of the points, then in voxel units: the conversion (a division) is monotonic,
+    // so this is the box of the converted points, at two conversions instead of one a point.
     let (lo, hi) = scan
         .endpoints
         .iter()
-        .fold((origin, origin), |(lo, hi), &p| {
-            let q = config.to_voxel_units(p);
-            (lo.min(q), hi.max(q))
+        .fold((scan.origin, scan.origin), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
         });
+    let (lo, hi) = (config.to_voxel_units(lo), config.to_voxel_units(hi));
     let margin = DVec3::splat(2.0 * HIT_NUDGE);
     let klo = floor_to_key(lo - margin).max(config.key_min());
     let khi = floor_to_key(hi + margin).min(config.key_max());

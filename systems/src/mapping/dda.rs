@@ -77,7 +77,10 @@ impl SegmentClipper {
         }
     }
 
-    /// The segment from the start to `end`, clipped ([`clip_segment`]).
+    /// The segment from the start to `end`, clipped ([`clip_segment`]). Always inlined: its
+    /// result then goes straight into the scan's clips, not through the stack (where a
+    /// profile of a Simple mission found 2.5 % of its samples on the copy).
+    #[inline(always)]
     pub fn clip(&self, end: DVec3) -> Option<ClippedSegment> {
         let Self {
             start,

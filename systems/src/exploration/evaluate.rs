@@ -6,15 +6,16 @@
 //! `All` evaluates every cluster in one parallel batch. `Ranked` walks the clusters in the
 //! strategy's order ([`evaluation_order`]) in batches of `needed`, and stops once `needed`
 //! candidates are choosable (rolled out, and affordable under a budget). Every cluster's
-//! evaluation is independent of which others are evaluated (its path comes from the same
-//! search over every goal; its fit, rollout and way home are its own), so the first `needed`
-//! choosable clusters in the order are the ones an evaluation of all would rank first, and the
-//! strategy picks the same one.
+//! evaluation is independent of which others are evaluated (its path is the one a search for
+//! every goal gives, though the search runs only as far as the batches so far need:
+//! [`TargetPaths`]; its fit, rollout and way home are its own), so the first `needed` choosable
+//! clusters in the order are the ones an evaluation of all would rank first, and the strategy
+//! picks the same one.
 
 use super::budget::return_energies;
 use super::propose::{ClusterTarget, MAX_EXPANSIONS, PlannedCandidate};
 use crate::flight::{FlightState, RolloutConfig, RolloutResult, rollout};
-use crate::planning::{SightMemo, TraversableGrid, find_paths, plan_along_seen};
+use crate::planning::{PathSearch, SightMemo, TraversableGrid, plan_along_seen};
 use crate::trajectory::DynamicLimits;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -23,18 +24,24 @@ use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{CandidateScope, Ranking};
 use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
 
-/// The paths of one multi-goal search from the UAV to every target's centroid and viewpoints.
-#[derive(Debug, Clone)]
-pub struct TargetPaths {
+/// The paths of one multi-goal search from the UAV to the targets' centroids and viewpoints,
+/// searched as far as the targets asked for so far need ([`PathSearch`]): a decision that
+/// finds its candidates among the first targets of its order stops there (the nearest-frontier
+/// strategy ranks by distance, so those are near), and each path is the one a search for
+/// every target would give.
+pub struct TargetPaths<'g> {
     goals: Vec<DVec3>,
     /// Index in `goals` of each target's centroid (its viewpoints follow).
     first_goal: Vec<usize>,
+    search: PathSearch<'g>,
+    /// Each goal's path, once its target was reached.
     paths: Vec<Option<Vec<DVec3>>>,
+    reached: Vec<bool>,
 }
 
-impl TargetPaths {
-    /// One search from `start` reaching every goal of `targets` ([`find_paths`]).
-    pub fn search(grid: &TraversableGrid, start: DVec3, targets: &[ClusterTarget]) -> Self {
+impl<'g> TargetPaths<'g> {
+    /// The search from `start` for the goals of `targets`, none searched yet.
+    pub fn new(grid: &'g TraversableGrid, start: DVec3, targets: &[ClusterTarget]) -> Self {
         let mut goals = Vec::new();
         let mut first_goal = Vec::with_capacity(targets.len());
         for target in targets {
@@ -42,17 +49,34 @@ impl TargetPaths {
             goals.push(target.centroid.as_dvec3());
             goals.extend(target.viewpoints.iter().map(|v| v.position.as_dvec3()));
         }
-        let paths = find_paths(grid, start, &goals, MAX_EXPANSIONS);
+        let search = PathSearch::new(grid, start, &goals, MAX_EXPANSIONS);
         Self {
+            paths: vec![None; goals.len()],
+            reached: vec![false; targets.len()],
             goals,
             first_goal,
-            paths,
+            search,
+        }
+    }
+
+    /// Searches on until every goal of the targets `which` has its path (or has none).
+    pub fn reach(&mut self, which: &[usize]) {
+        let mut goals = Vec::new();
+        for &target in which {
+            if !std::mem::replace(&mut self.reached[target], true) {
+                let end = self.first_goal.get(target + 1).copied();
+                goals.extend(self.first_goal[target]..end.unwrap_or(self.goals.len()));
+            }
+        }
+        for (goal, path) in goals.iter().zip(self.search.paths(&goals)) {
+            self.paths[*goal] = path;
         }
     }
 }
 
-/// Eaae.md step 6 for the targets `which` (indices into `targets`, which `paths` was searched
-/// for), in parallel, results in the order of `which`: the trajectory to a target's centroid,
+/// Eaae.md step 6 for the targets `which` (indices into `targets`, whose goals `paths` is the
+/// search for; it searches on as far as they need), in parallel, results in the order of
+/// `which`: the trajectory to a target's centroid,
 /// or failing that to each of its viewpoints in turn; targets without a feasible trajectory
 /// are left out. Goals within `min_travel_m` of the start are skipped: flying there gains
 /// nothing. The plans of each parallel job share one line-of-sight memo: the paths come from
@@ -61,11 +85,13 @@ pub fn plan_targets(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
     targets: &[ClusterTarget],
-    paths: &TargetPaths,
+    paths: &mut TargetPaths<'_>,
     which: &[usize],
     limits: &DynamicLimits,
     min_travel_m: f64,
 ) -> Vec<PlannedCandidate> {
+    paths.reach(which);
+    let paths = &*paths;
     which
         .par_iter()
         .map_init(
@@ -195,7 +221,7 @@ pub fn evaluate(
         return evaluation;
     }
     let searching = Instant::now();
-    let paths = TargetPaths::search(inputs.grid, inputs.start.position, targets);
+    let mut paths = TargetPaths::new(inputs.grid, inputs.start.position, targets);
     evaluation.trajectory_ms += elapsed_ms(searching);
     let order = evaluation_order(targets, position, scope);
     let (batch, needed) = match scope {
@@ -209,7 +235,7 @@ pub fn evaluate(
             inputs.grid,
             &inputs.start,
             targets,
-            &paths,
+            &mut paths,
             which,
             &inputs.limits,
             inputs.min_travel_m,

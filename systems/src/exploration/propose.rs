@@ -65,9 +65,9 @@ pub fn plan_candidates(
     limits: &DynamicLimits,
     min_travel_m: f64,
 ) -> Vec<PlannedCandidate> {
-    let paths = TargetPaths::search(grid, start.position, targets);
+    let mut paths = TargetPaths::new(grid, start.position, targets);
     let all: Vec<usize> = (0..targets.len()).collect();
-    plan_targets(grid, start, targets, &paths, &all, limits, min_travel_m)
+    plan_targets(grid, start, targets, &mut paths, &all, limits, min_travel_m)
 }
 
 /// Eaae.md step 7: the predicted energy and duration of every planned candidate, from the

@@ -15,6 +15,7 @@
 //! `grid.0.refresh(&map)` before they search, so the grid is recomputed only where the map
 //! changed and only when someone needs it.
 
+mod best_first;
 pub mod check;
 pub mod global;
 pub mod lattice;
@@ -34,7 +35,7 @@ pub use check::{
 };
 pub use global::{GlobalPlan, plan_along, plan_along_seen, plan_global};
 pub use local::{LocalPlan, plan_local};
-pub use search::{SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
+pub use search::{PathSearch, SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
 pub use sight::SightMemo;
 pub use traversable::TraversableGrid;
 

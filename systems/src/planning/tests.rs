@@ -354,30 +354,37 @@ fn enclosed_goals_and_limits_give_none() {
     );
 }
 
+/// A 6.4 x 6.4 x 2.4 m room of free space with a dozen random pillars (inflated by 0.27 m), a
+/// traversable start and a dozen random goals.
+fn random_room(rng: &mut ChaCha8Rng) -> (TraversableGrid, DVec3, Vec<DVec3>) {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 2.4));
+    map.fill_all(FREE);
+    for _ in 0..12 {
+        let lo = IVec3::new(rng.random_range(0..60), rng.random_range(0..60), 0);
+        let size = IVec3::new(rng.random_range(2..14), rng.random_range(2..14), 23);
+        map.fill(lo, lo + size, OCCUPIED);
+    }
+    let grid = map.grid(0.27);
+    let random_point = |rng: &mut ChaCha8Rng| {
+        DVec3::new(
+            rng.random_range(0.0..6.4),
+            rng.random_range(0.0..6.4),
+            rng.random_range(0.0..2.4),
+        )
+    };
+    let from = (0..1000)
+        .map(|_| random_point(rng))
+        .find(|&p| grid.is_traversable_point(p))
+        .unwrap();
+    let goals = (0..12).map(|_| random_point(rng)).collect();
+    (grid, from, goals)
+}
+
 #[test]
 fn find_paths_agrees_with_find_path_on_random_maps() {
     let mut rng = ChaCha8Rng::seed_from_u64(11);
     for _ in 0..3 {
-        let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 2.4));
-        map.fill_all(FREE);
-        for _ in 0..12 {
-            let lo = IVec3::new(rng.random_range(0..60), rng.random_range(0..60), 0);
-            let size = IVec3::new(rng.random_range(2..14), rng.random_range(2..14), 23);
-            map.fill(lo, lo + size, OCCUPIED);
-        }
-        let grid = map.grid(0.27);
-        let random_point = |rng: &mut ChaCha8Rng| {
-            DVec3::new(
-                rng.random_range(0.0..6.4),
-                rng.random_range(0.0..6.4),
-                rng.random_range(0.0..2.4),
-            )
-        };
-        let from = (0..1000)
-            .map(|_| random_point(&mut rng))
-            .find(|&p| grid.is_traversable_point(p))
-            .unwrap();
-        let goals: Vec<DVec3> = (0..12).map(|_| random_point(&mut rng)).collect();
+        let (grid, from, goals) = random_room(&mut rng);
         let many = find_paths(&grid, from, &goals, usize::MAX);
         let mut found = 0;
         for (goal, path) in goals.iter().zip(&many) {
@@ -393,7 +400,65 @@ fn find_paths_agrees_with_find_path_on_random_maps() {
     }
 }
 
-/// The pruning of the searches (`search::relaxed_by_parent`), bit by bit: it is linear in the
+/// A goal on the way to another: the search stops at the first, and must expand it when it
+/// goes on (in a corridor one cell wide, nothing else leads on).
+#[test]
+fn a_search_goes_on_through_the_goal_it_stopped_at() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 2.4, 0.8));
+    map.fill_all(OCCUPIED);
+    // Voxels y 10..=11, z 2..=3: one lattice cell across.
+    map.fill(IVec3::new(0, 10, 2), IVec3::new(63, 11, 3), FREE);
+    let grid = map.grid(0.0);
+    let at = |x: f64| DVec3::new(x, 1.1, 0.3);
+    let goals = [at(3.1), at(5.9)];
+    let all = find_paths(&grid, at(0.3), &goals, usize::MAX);
+    assert!(all.iter().all(Option::is_some));
+    let mut search = PathSearch::new(&grid, at(0.3), &goals, usize::MAX);
+    assert_eq!(search.paths(&[0])[0], all[0]);
+    assert_eq!(search.paths(&[1])[0], all[1]);
+}
+
+/// Goals asked for a few at a time, in any order and again, get exactly the paths of one
+/// search for all of them (with and without a limit on expansions, which counts over the
+/// whole search), and the search stops as soon as the goals asked for so far are settled.
+#[test]
+fn a_search_asked_goal_by_goal_gives_the_paths_of_one_search() {
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for _ in 0..4 {
+        let (grid, from, goals) = random_room(&mut rng);
+        let full = PathSearch::new(&grid, from, &goals, usize::MAX);
+        let expanded_for_all = {
+            let mut full = full;
+            full.paths(&(0..goals.len()).collect::<Vec<_>>());
+            full.expanded_cells()
+        };
+        for limit in [usize::MAX, expanded_for_all / 2] {
+            let all = find_paths(&grid, from, &goals, limit);
+            let mut search = PathSearch::new(&grid, from, &goals, limit);
+            let mut asked: Vec<usize> = (0..goals.len()).chain([0, 5]).collect();
+            asked.sort_by_key(|_| rng.random_range(0..100));
+            for batch in asked.chunks(rng.random_range(1..4)) {
+                for (&goal, path) in batch.iter().zip(search.paths(batch)) {
+                    assert_eq!(path, all[goal], "goal {goal} with limit {limit}");
+                }
+            }
+        }
+        // The nearest goal with a path, alone: a fraction of the cells.
+        let nearest = (0..goals.len())
+            .filter(|&g| find_path(&grid, from, goals[g], usize::MAX).is_some())
+            .min_by(|&a, &b| goals[a].distance(from).total_cmp(&goals[b].distance(from)))
+            .unwrap();
+        let mut search = PathSearch::new(&grid, from, &goals, usize::MAX);
+        assert!(search.paths(&[nearest])[0].is_some());
+        assert!(
+            search.expanded_cells() < expanded_for_all,
+            "{} of {expanded_for_all} cells for the nearest goal",
+            search.expanded_cells()
+        );
+    }
+}
+
+/// The pruning of the searches (`best_first::relaxed_by_parent`), bit by bit: it is linear in the
 /// parent's moves, so one parent move at a time covers every case. From a cell reached by move
 /// `d`, move `e` is skipped exactly when the parent allows `d + e`.
 #[test]
@@ -408,7 +473,7 @@ fn a_parents_moves_prune_the_moves_they_already_relaxed() {
                 .filter(|(_, e)| e.delta + d.delta == f.delta)
                 .fold(0u32, |bits, (i, _)| bits | 1 << i);
             assert_eq!(
-                search::relaxed_by_parent(k, 1 << j),
+                best_first::relaxed_by_parent(k, 1 << j),
                 expected,
                 "arrival {}, parent move {}",
                 d.delta,
@@ -445,7 +510,7 @@ fn pruned_searches_keep_every_cost_shortest() {
         let start = (0..lattice.len())
             .find(|&c| lattice.is_open(c))
             .expect("an open cell");
-        let costs = search::all_costs(lattice, start);
+        let costs = best_first::all_costs(lattice, start);
         let mut reached = 0;
         for cell in (0..lattice.len()).filter(|&c| costs[c] != u64::MAX) {
             reached += 1;

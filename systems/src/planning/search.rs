@@ -174,8 +174,10 @@ pub fn find_paths(
 pub struct PathSearch<'g> {
     grid: &'g TraversableGrid,
     start: Option<Endpoint>,
-    /// Where each goal joins the lattice (none when the start does not).
-    ends: Vec<Option<Endpoint>>,
+    goals: Vec<DVec3>,
+    /// Where each goal joins the lattice, found when it is first asked for (attaching every
+    /// goal of a decision up front cost 1 % of a mission).
+    ends: Vec<Option<Option<Endpoint>>>,
     max_expansions: usize,
     /// One bit per lattice cell, set for the cells of goals asked for and not yet settled:
     /// the test runs for every cell the search settles, and a bit lookup stays in cache where
@@ -194,18 +196,11 @@ impl<'g> PathSearch<'g> {
         goals: &[DVec3],
         max_expansions: usize,
     ) -> Self {
-        let start = attach(grid, from, SNAP_RADIUS_M);
-        let ends = match start {
-            Some(_) => goals
-                .iter()
-                .map(|&g| attach(grid, g, GOAL_SNAP_RADIUS_M))
-                .collect(),
-            None => vec![None; goals.len()],
-        };
         Self {
             grid,
-            start,
-            ends,
+            start: attach(grid, from, SNAP_RADIUS_M),
+            goals: goals.to_vec(),
+            ends: vec![None; goals.len()],
             max_expansions,
             pending: Vec::new(),
             remaining: 0,
@@ -225,7 +220,11 @@ impl<'g> PathSearch<'g> {
             return vec![None; which.len()];
         };
         let lattice = self.grid.lattice();
-        for end in which.iter().filter_map(|&goal| self.ends[goal].as_ref()) {
+        for &goal in which {
+            let (grid, point) = (self.grid, self.goals[goal]);
+            self.ends[goal].get_or_insert_with(|| attach(grid, point, GOAL_SNAP_RADIUS_M));
+        }
+        for end in which.iter().filter_map(|&goal| self.ends[goal].flatten()) {
             if self
                 .search
                 .as_ref()
@@ -257,13 +256,13 @@ impl<'g> PathSearch<'g> {
         which
             .iter()
             .map(|&goal| {
-                let end = self.ends[goal].as_ref()?;
+                let end = self.ends[goal].flatten()?;
                 let search = self.search.as_ref()?;
                 let cells = search
                     .nodes()
                     .is_closed(end.cell)
                     .then(|| search.trace(lattice.moves(), end.cell))?;
-                Some(assemble(self.grid, &start, &cells, end))
+                Some(assemble(self.grid, &start, &cells, &end))
             })
             .collect()
     }

@@ -76,10 +76,9 @@ impl<'g> TargetPaths<'g> {
 
 /// Eaae.md step 6 for the targets `which` (indices into `targets`, whose goals `paths` is the
 /// search for; it searches on as far as they need), in parallel, results in the order of
-/// `which`: the trajectory to a target's centroid,
-/// or failing that to each of its viewpoints in turn; targets without a feasible trajectory
-/// are left out. Goals within `min_travel_m` of the start are skipped: flying there gains
-/// nothing. The plans of each parallel job share one line-of-sight memo: the paths come from
+/// `which`: the trajectory to a target's centroid, or failing that to each of its viewpoints
+/// in turn; targets without a feasible trajectory are left out. Goals within `min_travel_m`
+/// of the start are skipped: flying there gains nothing. The plans of each parallel job share one line-of-sight memo: the paths come from
 /// one search tree and ask the same questions ([`crate::planning::sight`]).
 pub fn plan_targets(
     grid: &TraversableGrid,

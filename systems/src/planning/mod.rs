@@ -3,8 +3,10 @@
 //! - [`traversable`]: the map's known free space shrunk by the UAV's radius, kept per chunk and
 //!   refreshed lazily where the map changed ([`TraversableGrid`]).
 //! - [`lattice`]: the 2-voxel search lattice over it.
-//! - [`search`]: A* ([`find_path`]), one Dijkstra to many goals ([`find_paths`]), and the
-//!   line-of-sight [`shortcut`].
+//! - `best_first`: the searches' engine (Dijkstra or A* on the lattice, a bucket queue, cell
+//!   state kept from one search to the next), which can pause at a settled cell and go on.
+//! - [`search`]: A* ([`find_path`]), one Dijkstra to many goals ([`find_paths`], or as far as
+//!   the goals asked for so far need: [`PathSearch`]), and the line-of-sight [`shortcut`].
 //! - [`global`]: a feasible, collision-free minimum-snap trajectory along a path
 //!   ([`plan_along`], [`plan_global`]).
 //! - [`local`]: the receding-horizon planner that flies toward the chosen goal ([`plan_local`]).

@@ -30,12 +30,12 @@ use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
 /// strategy ranks by distance, so those are near), and each path is the one a search for
 /// every target would give.
 pub struct TargetPaths<'g> {
-    goals: Vec<DVec3>,
-    /// Index in `goals` of each target's centroid (its viewpoints follow).
+    /// Index in the search's goals of each target's centroid (its viewpoints follow).
     first_goal: Vec<usize>,
     search: PathSearch<'g>,
     /// Each goal's path, once its target was reached.
     paths: Vec<Option<Vec<DVec3>>>,
+    /// Per target, whether its goals' paths are in `paths`.
     reached: Vec<bool>,
 }
 
@@ -53,7 +53,6 @@ impl<'g> TargetPaths<'g> {
         Self {
             paths: vec![None; goals.len()],
             reached: vec![false; targets.len()],
-            goals,
             first_goal,
             search,
         }
@@ -65,7 +64,7 @@ impl<'g> TargetPaths<'g> {
         for &target in which {
             if !std::mem::replace(&mut self.reached[target], true) {
                 let end = self.first_goal.get(target + 1).copied();
-                goals.extend(self.first_goal[target]..end.unwrap_or(self.goals.len()));
+                goals.extend(self.first_goal[target]..end.unwrap_or(self.paths.len()));
             }
         }
         for (goal, path) in goals.iter().zip(self.search.paths(&goals)) {
@@ -78,8 +77,9 @@ impl<'g> TargetPaths<'g> {
 /// search for; it searches on as far as they need), in parallel, results in the order of
 /// `which`: the trajectory to a target's centroid, or failing that to each of its viewpoints
 /// in turn; targets without a feasible trajectory are left out. Goals within `min_travel_m`
-/// of the start are skipped: flying there gains nothing. The plans of each parallel job share one line-of-sight memo: the paths come from
-/// one search tree and ask the same questions ([`crate::planning::sight`]).
+/// of the start are skipped: flying there gains nothing. The plans of each parallel job share
+/// one line-of-sight memo: the paths come from one search tree and ask the same questions
+/// ([`crate::planning::sight`]).
 pub fn plan_targets(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -107,7 +107,7 @@ pub fn plan_targets(
                 );
                 options.enumerate().find_map(|(k, (viewpoint, yaw))| {
                     let path = paths.paths[first + k].as_ref()?;
-                    if paths.goals[first + k].distance(start.position) <= min_travel_m {
+                    if paths.search.goals()[first + k].distance(start.position) <= min_travel_m {
                         return None;
                     }
                     let plan = plan_along_seen(sight, start, path, yaw, limits).ok()?;

@@ -9,6 +9,7 @@
 
 mod box_cast;
 mod frustum;
+mod packet;
 mod pattern;
 mod sweep;
 

@@ -4,8 +4,9 @@
 use super::RayPattern;
 use super::box_cast::LocalBox;
 use super::frustum::{Frustum, RayTile};
+use super::packet::{Directions, LANES};
 use bevy_ecs::prelude::*;
-use glam::{Quat, Vec3, Vec3A};
+use glam::{BVec4A, Quat, Vec3, Vec3A, Vec4};
 use parry3d::bounding_volume::{Aabb, BoundingVolume};
 use parry3d::query::Ray;
 use rand_chacha::ChaCha8Rng;
@@ -115,10 +116,11 @@ pub fn sweep(
     let gaussian = Normal::new(0.0f32, std_m).ok().filter(|_| std_m > 0.0);
     let cast_range = pattern.range_max + 4.0 * std_m;
 
-    scratch.world_directions.clear();
-    scratch
-        .world_directions
-        .extend(pattern.directions.iter().map(|d| pose.rotation * *d));
+    rotate_all(
+        pose.rotation,
+        &pattern.directions,
+        &mut scratch.world_directions,
+    );
     cast_sweep(
         world,
         pose.origin,
@@ -159,6 +161,19 @@ pub fn sweep(
     }
     scan.sequence += 1;
     scan.time_s = time_s;
+}
+
+/// `directions` rotated by `rotation` into `out` (`rotation * d` for each, four at a time:
+/// the same bits, `super::packet`).
+fn rotate_all(rotation: Quat, directions: &[Vec3], out: &mut Vec<Vec3>) {
+    out.clear();
+    let mut packets = directions.chunks_exact(LANES);
+    for packet in &mut packets {
+        let packet: &[Vec3; LANES] = packet.try_into().expect("a whole packet");
+        let rotated = Directions::of(packet).rotated(rotation);
+        out.extend((0..LANES).map(|lane| rotated.lane(lane)));
+    }
+    out.extend(packets.remainder().iter().map(|d| rotation * *d));
 }
 
 /// Most obstacles within a sweep's range for which the sweep casts its rays against each of them
@@ -309,15 +324,60 @@ fn cast_sweep(
         }
         hit.then_some(best)
     };
+    // Four rays at a time (`super::packet`), each lane exactly the one-ray `cast` above. A lane
+    // goes on past an obstacle its own ray would have stopped at (one whose box lies beyond
+    // its nearest hit so far): no hit there can come nearer, so its answer stays the same.
+    let cast4 = |dirs: &[Vec3; LANES], near: &[NearObstacle]| -> [Option<f32>; LANES] {
+        let packet = Directions::of(dirs);
+        let mut best = Vec4::splat(range);
+        let mut hit = BVec4A::FALSE;
+        for n in near {
+            if Vec4::splat(n.nearest).cmpgt(best).all() {
+                break;
+            }
+            let local = packet.rotated(n.to_local);
+            match &n.cuboid {
+                Some(local_box) => {
+                    let found = local_box.cast4(n.local_origin, &local, best);
+                    let nearer = found.hit & found.toi.cmplt(best);
+                    best = Vec4::select(nearer, found.toi, best);
+                    hit |= nearer;
+                }
+                None => {
+                    for lane in 0..LANES {
+                        let toi = obstacles[n.index].shape.cast_local_ray(
+                            &Ray::new(n.local_origin.into(), local.lane(lane)),
+                            best[lane],
+                            true,
+                        );
+                        if let Some(toi) = toi
+                            && toi < best[lane]
+                        {
+                            best[lane] = toi;
+                            hit.set(lane, true);
+                        }
+                    }
+                }
+            }
+        }
+        std::array::from_fn(|lane| hit.test(lane).then_some(best[lane]))
+    };
+    let cast_all = |dirs: &[Vec3], out: &mut [Option<f32>], near: &[NearObstacle]| {
+        let mut packets = dirs.chunks_exact(LANES);
+        let mut slots = out.chunks_exact_mut(LANES);
+        for (packet, slots) in (&mut packets).zip(&mut slots) {
+            let packet: &[Vec3; LANES] = packet.try_into().expect("a whole packet");
+            slots.copy_from_slice(&cast4(packet, near));
+        }
+        for (dir, slot) in packets.remainder().iter().zip(slots.into_remainder()) {
+            *slot = cast(*dir, near);
+        }
+    };
     if directions.len() >= PARALLEL_RAY_THRESHOLD {
         directions
             .par_chunks(PARALLEL_RAY_CHUNK)
             .zip(out.par_chunks_mut(PARALLEL_RAY_CHUNK))
-            .for_each(|(dirs, out)| {
-                for (dir, slot) in dirs.iter().zip(out) {
-                    *slot = cast(*dir, &near.all);
-                }
-            });
+            .for_each(|(dirs, out)| cast_all(dirs, out, &near.all));
     } else if let Some(tiles) = culling.tiles {
         // Tile by tile, each ray against the obstacles its tile can reach (a subset of the
         // near ones in the same order: the same nearest hit).
@@ -331,18 +391,15 @@ fn cast_sweep(
             near.tile.extend(reached);
             for row in tile.rows.clone() {
                 let rays = row * tiles.columns..;
-                for (dir, slot) in directions[rays.clone()][tile.columns.clone()]
-                    .iter()
-                    .zip(&mut out[rays][tile.columns.clone()])
-                {
-                    *slot = cast(*dir, &near.tile);
-                }
+                cast_all(
+                    &directions[rays.clone()][tile.columns.clone()],
+                    &mut out[rays][tile.columns.clone()],
+                    &near.tile,
+                );
             }
         }
     } else {
-        for (dir, slot) in directions.iter().zip(out.iter_mut()) {
-            *slot = cast(*dir, &near.all);
-        }
+        cast_all(directions, out, &near.all);
     }
 }
 
@@ -554,6 +611,39 @@ mod tests {
         let hit = direct[0].expect("a hit");
         assert!((hit - 3.75 * 4.0f32.hypot(1.0) / 4.0).abs() < 1e-4, "{hit}");
         assert_eq!(direct, reference);
+    }
+
+    /// A surface exactly at the range is no hit (the ray is cut there), for rays cast four at a
+    /// time as for a ray cast alone, and as for the hierarchy.
+    #[test]
+    fn a_surface_at_the_range_is_no_hit_in_packets_too() {
+        let world = WorldGeometry::new(vec![cuboid(
+            "wall",
+            Vec3::new(5.5, 0.0, 1.0),
+            Vec3::new(1.0, 10.0, 2.0),
+            0.0,
+        )])
+        .unwrap();
+        let origin = Vec3::new(0.0, 0.0, 1.0);
+        // Four rays straight at the wall 5 m away (a packet), then one alone; a range of 5 m
+        // and one of 6 m.
+        let directions = [Vec3::X; 5];
+        for (range, expected) in [(5.0, None), (6.0, Some(5.0))] {
+            let (mut near, mut direct, mut reference) =
+                (NearObstacles::default(), Vec::new(), Vec::new());
+            cast_sweep(
+                &world,
+                origin,
+                &directions,
+                Culling::default(),
+                range,
+                &mut near,
+                &mut direct,
+            );
+            world.cast_rays(origin, &directions, range, &mut reference);
+            assert_eq!(direct, vec![expected; 5], "range {range}");
+            assert_eq!(direct, reference, "range {range}");
+        }
     }
 
     /// The direct casts give the hierarchy's distances to the bit, whether a ray hits a face, an

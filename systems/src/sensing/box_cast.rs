@@ -152,36 +152,56 @@ mod tests {
         );
     }
 
+    /// A box's half extents.
+    fn random_half(rng: &mut ChaCha8Rng) -> Vec3 {
+        Vec3::new(
+            rng.random_range(0.05..10.0),
+            rng.random_range(0.05..10.0),
+            rng.random_range(0.05..10.0),
+        )
+    }
+
+    /// An origin around the box of `half`, on one of its faces' planes now and then.
+    fn random_origin(rng: &mut ChaCha8Rng, half: Vec3) -> Vec3 {
+        let mut origin = Vec3::new(
+            rng.random_range(-15.0..15.0),
+            rng.random_range(-15.0..15.0),
+            rng.random_range(-15.0..15.0),
+        );
+        for axis in 0..3 {
+            if rng.random_range(0..6) == 0 {
+                origin[axis] = half[axis] * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+            }
+        }
+        origin
+    }
+
+    /// A direction, with components exactly zero (either sign) now and then: rays along faces
+    /// and axes.
+    fn random_direction(rng: &mut ChaCha8Rng) -> Vec3 {
+        let mut dir = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        );
+        for axis in 0..3 {
+            match rng.random_range(0..8) {
+                0 => dir[axis] = 0.0,
+                1 => dir[axis] = -0.0,
+                _ => {}
+            }
+        }
+        dir
+    }
+
     #[test]
     fn equals_parry_to_the_bit_on_random_rays() {
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let mut hits = 0;
         for case in 0..200_000 {
-            let half = Vec3::new(
-                rng.random_range(0.05..10.0),
-                rng.random_range(0.05..10.0),
-                rng.random_range(0.05..10.0),
-            );
-            let mut origin = Vec3::new(
-                rng.random_range(-15.0..15.0),
-                rng.random_range(-15.0..15.0),
-                rng.random_range(-15.0..15.0),
-            );
-            let mut dir = Vec3::new(
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-                rng.random_range(-1.0..1.0),
-            );
-            // Rays along faces and axes: some components exactly zero (either sign), some
-            // origins exactly on a face.
-            for axis in 0..3 {
-                match rng.random_range(0..8) {
-                    0 => dir[axis] = 0.0,
-                    1 => dir[axis] = -0.0,
-                    2 => origin[axis] = half[axis] * if rng.random_bool(0.5) { 1.0 } else { -1.0 },
-                    _ => {}
-                }
-            }
+            let half = random_half(&mut rng);
+            let origin = random_origin(&mut rng, half);
+            let dir = random_direction(&mut rng);
             let max_toi = rng.random_range(0.0..30.0);
             let expected = parry(half, origin, dir, max_toi);
             let got = cast_local_box(half, origin, dir, max_toi);
@@ -203,36 +223,9 @@ mod tests {
         let mut rng = ChaCha8Rng::seed_from_u64(6);
         let mut hits = 0;
         for case in 0..50_000 {
-            let half = Vec3::new(
-                rng.random_range(0.05..10.0),
-                rng.random_range(0.05..10.0),
-                rng.random_range(0.05..10.0),
-            );
-            let mut origin = Vec3::new(
-                rng.random_range(-15.0..15.0),
-                rng.random_range(-15.0..15.0),
-                rng.random_range(-15.0..15.0),
-            );
-            for axis in 0..3 {
-                if rng.random_range(0..6) == 0 {
-                    origin[axis] = half[axis] * if rng.random_bool(0.5) { 1.0 } else { -1.0 };
-                }
-            }
-            let directions = [0; 4].map(|_| {
-                let mut dir = Vec3::new(
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                    rng.random_range(-1.0..1.0),
-                );
-                for axis in 0..3 {
-                    match rng.random_range(0..8) {
-                        0 => dir[axis] = 0.0,
-                        1 => dir[axis] = -0.0,
-                        _ => {}
-                    }
-                }
-                dir
-            });
+            let half = random_half(&mut rng);
+            let origin = random_origin(&mut rng, half);
+            let directions = [0; 4].map(|_| random_direction(&mut rng));
             let max_toi = Vec4::from_array([0; 4].map(|_| rng.random_range(0.0..30.0)));
             let local_box = LocalBox::of(&Cuboid::new(half));
             let four = local_box.cast4(origin.into(), &Directions::of(&directions), max_toi);

@@ -1,7 +1,7 @@
 //! The ray test of a box-shaped obstacle in its own frame: parry's
 //! (`Cuboid::cast_local_ray`, i.e. `Aabb::cast_local_ray` of `-half..=half`, solid), with the
-//! same operations in the same order, the three axes at once in one SIMD register and
-//! without branches.
+//! same operations in the same order, without branches, for four rays at once
+//! ([`LocalBox::cast4`], one ray per SIMD lane: `super::packet`).
 //!
 //! Why not call parry's: most of a sweep's ray tests are against boxes (walls, pillars, the
 //! ground), and parry's test is an out-of-line call whose slab loop returns early and swaps
@@ -11,8 +11,9 @@
 //! axis, so an interval found empty at one axis stays empty, and an axis the ray does not
 //! move along either rejects the ray outright or leaves the interval as it was. Each
 //! parameter is the same expression, rounded the same way, as parry's: the hit distances
-//! are the same to the bit (tested below against parry on random rays, and in `sweep`
-//! against the world's hierarchy).
+//! are the same to the bit. The tests below show it on random rays for the one-ray form
+//! ([`LocalBox::cast`], the three axes in one register) against parry, and for the
+//! four-ray form against the one-ray form; `sweep`'s, against the world's hierarchy.
 
 use super::packet::{Directions, Hits};
 use glam::{BVec4A, Vec3A, Vec4};
@@ -37,8 +38,9 @@ impl LocalBox {
 
     /// Where the ray `origin + t dir` (in the box's frame) first meets the solid box within
     /// `t <= max_toi` (0 when the origin is inside), or `None`: parry's
-    /// `Cuboid::cast_local_ray(ray, max_toi, true)`.
-    #[inline(always)]
+    /// `Cuboid::cast_local_ray(ray, max_toi, true)`. The sweeps cast four rays at a time
+    /// ([`Self::cast4`]); this one-ray form is the reference the tests hold both to.
+    #[cfg(test)]
     pub fn cast(&self, origin: Vec3A, dir: Vec3A, max_toi: f32) -> Option<f32> {
         let Self { lo, hi } = *self;
         // An axis the ray does not move along: outside its slab, never in the box.

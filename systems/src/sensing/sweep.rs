@@ -298,35 +298,11 @@ fn cast_sweep(
     out.clear();
     out.resize(directions.len(), None);
     let obstacles = world.obstacles();
-    let cast = |dir: Vec3, near: &[NearObstacle]| {
-        let mut best = range;
-        let mut hit = false;
-        for n in near {
-            if n.nearest > best {
-                break;
-            }
-            // `Quat * Vec3` is this rotation too, with the conversions around it.
-            let local_dir = n.to_local.mul_vec3a(dir.into());
-            let toi = match &n.cuboid {
-                Some(local_box) => local_box.cast(n.local_origin, local_dir, best),
-                None => obstacles[n.index].shape.cast_local_ray(
-                    &Ray::new(n.local_origin.into(), local_dir.into()),
-                    best,
-                    true,
-                ),
-            };
-            if let Some(toi) = toi
-                && toi < best
-            {
-                best = toi;
-                hit = true;
-            }
-        }
-        hit.then_some(best)
-    };
-    // Four rays at a time (`super::packet`), each lane exactly the one-ray `cast` above. A lane
-    // goes on past an obstacle its own ray would have stopped at (one whose box lies beyond
-    // its nearest hit so far): no hit there can come nearer, so its answer stays the same.
+    // Four rays at a time (`super::packet`), each lane what the ray alone would give: tried
+    // against the obstacles nearest box first, its nearest hit closer than the range winning.
+    // A lane goes on past an obstacle its own ray would have stopped at (one whose box lies
+    // beyond its nearest hit so far): no hit there can come nearer, so its answer stays the
+    // same.
     let cast4 = |dirs: &[Vec3; LANES], near: &[NearObstacle]| -> [Option<f32>; LANES] {
         let packet = Directions::of(dirs);
         let mut best = Vec4::splat(range);
@@ -369,8 +345,11 @@ fn cast_sweep(
             let packet: &[Vec3; LANES] = packet.try_into().expect("a whole packet");
             slots.copy_from_slice(&cast4(packet, near));
         }
-        for (dir, slot) in packets.remainder().iter().zip(slots.into_remainder()) {
-            *slot = cast(*dir, near);
+        // The last rays in a packet padded with copies of the last one.
+        let (rest, rest_slots) = (packets.remainder(), slots.into_remainder());
+        if let Some(&last) = rest.last() {
+            let packet = std::array::from_fn(|lane| rest.get(lane).copied().unwrap_or(last));
+            rest_slots.copy_from_slice(&cast4(&packet, near)[..rest.len()]);
         }
     };
     if directions.len() >= PARALLEL_RAY_THRESHOLD {

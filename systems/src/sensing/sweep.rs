@@ -345,7 +345,9 @@ fn cast_sweep(
             let packet: &[Vec3; LANES] = packet.try_into().expect("a whole packet");
             slots.copy_from_slice(&cast4(packet, near));
         }
-        // The last rays in a packet padded with copies of the last one.
+        // The last rays in a packet padded with copies of the last one. (Whole packets stay
+        // on their own loop of fixed-size copies: one padded-packet iterator for all of them
+        // made the sense stage 45 % slower, a variable-length copy per packet.)
         let (rest, rest_slots) = (packets.remainder(), slots.into_remainder());
         if let Some(&last) = rest.last() {
             let packet = std::array::from_fn(|lane| rest.get(lane).copied().unwrap_or(last));

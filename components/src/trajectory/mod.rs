@@ -60,4 +60,11 @@ pub trait Trajectory: Send + Sync + std::fmt::Debug {
     fn duration(&self) -> f64;
     /// The reference at time `t` (s since the start).
     fn sample(&self, t: f64) -> TrajectoryPoint;
+
+    /// The position at time `t`: `self.sample(t).position`, bit for bit. Implementations
+    /// override it when the position alone is cheaper to compute (collision checks sample
+    /// positions only).
+    fn position(&self, t: f64) -> DVec3 {
+        self.sample(t).position
+    }
 }

@@ -63,7 +63,7 @@ pub fn sample(trajectory: &dyn Trajectory) -> Vec<[f32; 3]> {
     (0..=steps)
         .map(|i| {
             let t = (i as f64 * SAMPLE_STEP_S).min(duration);
-            trajectory.sample(t).position.as_vec3().to_array()
+            trajectory.position(t).as_vec3().to_array()
         })
         .collect()
 }

@@ -17,66 +17,33 @@ use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
 use crate::mapping::OccupancyMap;
 use glam::DVec3;
-use uavex_components::trajectory::{PiecewisePolynomial, Trajectory};
+use uavex_components::trajectory::Trajectory;
 
 /// The first sample from `t0` on that breaks the traversability (with the escape rule of the
 /// module doc), as (time, position); `None` when there is none. Non-positive or non-finite
-/// `max_speed` or times count as a failure at `t0`.
+/// `max_speed` or times count as a failure at `t0`. Samples positions only
+/// ([`Trajectory::position`]: a fifth of a full sample's work for a polynomial).
 pub fn first_untraversable(
     grid: &TraversableGrid,
-    trajectory: &dyn Trajectory,
+    trajectory: &(impl Trajectory + ?Sized),
     t0: f64,
     max_speed: f64,
 ) -> Option<(f64, DVec3)> {
-    scan(
-        grid,
-        trajectory.duration(),
-        |t| trajectory.sample(t).position,
-        t0,
-        max_speed,
-    )
-}
-
-/// [`first_untraversable`] for a piecewise polynomial, evaluating positions only (the full
-/// sample also forms four derivatives of four outputs, five times the work, at every 5 cm).
-/// Same samples, same positions bit for bit, same answer.
-pub fn first_untraversable_polynomial(
-    grid: &TraversableGrid,
-    trajectory: &PiecewisePolynomial,
-    t0: f64,
-    max_speed: f64,
-) -> Option<(f64, DVec3)> {
-    scan(
-        grid,
-        trajectory.duration(),
-        |t| polynomial_position(trajectory, t),
-        t0,
-        max_speed,
-    )
-}
-
-/// `trajectory.sample(t).position`, computed as `PolynomialSegment::derivatives` computes its
-/// order 0 (Horner from the highest coefficient, times a scale of exactly 1).
-pub fn polynomial_position(trajectory: &PiecewisePolynomial, t: f64) -> DVec3 {
-    let segments = trajectory.segments();
-    let (segment, tau) = if t >= trajectory.duration() {
-        (&segments[segments.len() - 1], 1.0)
-    } else {
-        let (index, tau) = trajectory.locate(t);
-        (&segments[index], tau)
+    let end = trajectory.duration();
+    let Some(times) = sample_times(end, t0, max_speed) else {
+        return Some((t0, trajectory.position(0.0)));
     };
-    let axis = |c: &[f64; 8]| {
-        let mut acc = 0.0;
-        for k in (0..c.len()).rev() {
-            acc = acc * tau + c[k];
+    let origin = trajectory.position(t0.clamp(0.0, end));
+    let mut escaping = !grid.is_traversable_point(origin);
+    for t in times {
+        let p = trajectory.position(t);
+        if grid.is_traversable_point(p) {
+            escaping = false;
+        } else if !escaping || p.distance(origin) > SNAP_RADIUS_M {
+            return Some((t, p));
         }
-        acc
-    };
-    DVec3::new(
-        axis(&segment.coefficients[0]),
-        axis(&segment.coefficients[1]),
-        axis(&segment.coefficients[2]),
-    )
+    }
+    None
 }
 
 /// The sample times of the checks: every `COLLISION_SAMPLE_SPACING_M / max_speed` from `t0`
@@ -93,30 +60,6 @@ fn sample_times(end: f64, t0: f64, max_speed: f64) -> Option<impl Iterator<Item 
     Some((0..=samples).map(move |i| (t0 + i as f64 * step).min(end)))
 }
 
-/// The sampling loop of [`first_untraversable`] over any position function of time.
-fn scan(
-    grid: &TraversableGrid,
-    end: f64,
-    position: impl Fn(f64) -> DVec3,
-    t0: f64,
-    max_speed: f64,
-) -> Option<(f64, DVec3)> {
-    let Some(times) = sample_times(end, t0, max_speed) else {
-        return Some((t0, position(0.0)));
-    };
-    let origin = position(t0.clamp(0.0, end));
-    let mut escaping = !grid.is_traversable_point(origin);
-    for t in times {
-        let p = position(t);
-        if grid.is_traversable_point(p) {
-            escaping = false;
-        } else if !escaping || p.distance(origin) > SNAP_RADIUS_M {
-            return Some((t, p));
-        }
-    }
-    None
-}
-
 /// Brings the grid up to date where [`remains_traversable`] will look along `trajectory`
 /// from `t0` (the chunks under its samples), leaving the rest of the grid's dirty chunks for
 /// the next full [`TraversableGrid::refresh`]: a periodic check of the flown trajectory need
@@ -124,15 +67,14 @@ fn scan(
 pub fn refresh_along(
     grid: &mut TraversableGrid,
     map: &impl OccupancyMap,
-    trajectory: &dyn Trajectory,
+    trajectory: &(impl Trajectory + ?Sized),
     t0: f64,
     max_speed: f64,
 ) {
     let end = trajectory.duration();
-    let origin = trajectory.sample(t0.clamp(0.0, end.max(0.0))).position;
-    grid.refresh_at(map, origin);
+    grid.refresh_at(map, trajectory.position(t0.clamp(0.0, end.max(0.0))));
     for t in sample_times(end, t0, max_speed).into_iter().flatten() {
-        grid.refresh_at(map, trajectory.sample(t).position);
+        grid.refresh_at(map, trajectory.position(t));
     }
 }
 
@@ -141,7 +83,7 @@ pub fn refresh_along(
 /// airframe's vmax for planned trajectories).
 pub fn remains_traversable(
     grid: &TraversableGrid,
-    trajectory: &dyn Trajectory,
+    trajectory: &(impl Trajectory + ?Sized),
     t0: f64,
     max_speed: f64,
 ) -> bool {

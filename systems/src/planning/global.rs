@@ -15,7 +15,7 @@
 //! Headings face the direction of travel at every waypoint (the depth camera looks forward,
 //! where the UAV is going), and `end_yaw` at the end when given.
 
-use super::check::first_untraversable_polynomial;
+use super::check::first_untraversable;
 use super::search::{MIN_POINT_SEPARATION_M, find_path, path_length, shortcut_indices};
 use super::sight::SightMemo;
 use super::traversable::TraversableGrid;
@@ -174,7 +174,7 @@ fn fit(
             .collect();
         let trajectory = plan_min_snap(start, &waypoints, limits)?;
         let Some((time_s, position)) =
-            first_untraversable_polynomial(grid, &trajectory, 0.0, limits.max_velocity)
+            first_untraversable(grid, &trajectory, 0.0, limits.max_velocity)
         else {
             return Ok(trajectory);
         };

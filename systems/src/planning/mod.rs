@@ -31,10 +31,7 @@ mod tests;
 #[cfg(test)]
 mod tests_planner;
 
-pub use check::{
-    first_untraversable, first_untraversable_polynomial, polynomial_position, refresh_along,
-    remains_traversable,
-};
+pub use check::{first_untraversable, refresh_along, remains_traversable};
 pub use global::{GlobalPlan, plan_along, plan_along_seen, plan_global};
 pub use local::{LocalPlan, plan_local};
 pub use search::{PathSearch, SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};

@@ -32,7 +32,7 @@ pub fn first_blocked(
     let samples = (end / step).ceil() as u64;
     for i in 0..=samples {
         let t = (i as f64 * step).min(end);
-        let position = trajectory.sample(t).position;
+        let position = trajectory.position(t);
         if blocked(position) {
             return Ok(Some((t, position)));
         }

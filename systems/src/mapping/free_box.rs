@@ -1,5 +1,5 @@
-//! The free boxes of a scan: boxes of saturated free bricks around the sensor, grown once per
-//! scan, that every ray of the scan leaves in one move each.
+//! The free boxes of a scan: boxes of saturated free bricks around the sensor and beyond it,
+//! grown once per scan, that the rays of the scan leave in one move each.
 //!
 //! Why: near itself a camera in flight sees space it saw a few frames before, saturated free,
 //! where a miss changes nothing (common.md §1: clamping). The walks cross such space cube by
@@ -14,12 +14,16 @@
 //!
 //! The map that results is the same bit for bit. A box is grown greedily, one brick layer per
 //! face in turn (+x, -x, +y, -y, +z, -z), while the new layer's bricks are all full: not the
-//! largest box there is, but deterministic and cheap (a bit test per brick). One brick that is
-//! not full stops a face across the whole box, so [`FreeBoxes`] also grows two boxes that take
-//! x, or y, to the end first and then the rest: along a free corridor or the length of a room
-//! they reach farther, and a ray that leaves one box may still be inside another (in the
-//! shipped Pillars mission the two more boxes took 3-5 % off the map update, 2-3 % off the
-//! mission, in paired rounds; a third, z first, nothing more).
+//! largest box there is, but deterministic and cheap (a bit test per brick, on the scan's
+//! `super::full_bricks::FullBricks`). One brick that is not full stops a face across the
+//! whole box, so [`FreeBoxes`] also grows two boxes that take x, or y, to the end first and
+//! then the rest: along a free corridor or the length of a room they reach farther, and a ray
+//! that leaves one box may still be inside another (in the shipped Pillars mission the two more
+//! boxes took 3-5 % off the map update, 2-3 % off the mission, in paired rounds; a third, z
+//! first, nothing more). And beyond each face of the first box it grows one more from the
+//! brick past the face's centre: a walk that leaves the boxes around the sensor through a face
+//! stopped by one brick (a pillar's corner, a patch of floor not yet saturated) mostly goes on
+//! through free space, and a box there takes it on, or holds its end.
 
 use super::cube::{CubeCrossing, cross_faces};
 use glam::IVec3;
@@ -127,41 +131,109 @@ impl FreeBox {
     }
 }
 
-/// The free boxes of one scan ([`FreeBox::grow`]): the one grown with all faces in turn, then
-/// those grown x first and y first, each only if it differs from the ones before.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct FreeBoxes([Option<FreeBox>; 3]);
+/// The free boxes of one scan ([`FreeBoxes::grow`]), at most [`MAX_FREE_BOXES`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FreeBoxes {
+    boxes: [FreeBox; MAX_FREE_BOXES],
+    len: usize,
+    /// How many of the boxes were grown around the sensor (the first ones).
+    around: usize,
+}
+
+/// How many boxes a scan keeps: the three around the sensor and one beyond each of the first
+/// one's six faces.
+pub const MAX_FREE_BOXES: usize = 9;
+
+impl Default for FreeBoxes {
+    fn default() -> Self {
+        let empty = FreeBox {
+            lo: IVec3::MAX,
+            hi: IVec3::MIN,
+        };
+        Self {
+            boxes: [empty; MAX_FREE_BOXES],
+            len: 0,
+            around: 0,
+        }
+    }
+}
 
 impl FreeBoxes {
-    /// The boxes around `origin` ([`FreeBox::grow`]); none when the origin's brick is not full.
+    /// The boxes of a scan whose sensor is at key `origin`, within the bricks that meet the
+    /// key box `limit_lo..=limit_hi` (`full` as for [`FreeBox::grow`]); none when the origin's
+    /// brick is not full:
+    /// - around the sensor, the box grown with all faces in turn, then those grown x first and
+    ///   y first (each only if it differs from the ones before);
+    /// - beyond each face of the first one, the box grown with all faces in turn from the brick
+    ///   just past the face's centre, if full (see the module documentation).
+    ///
+    /// In the shipped Pillars mission the boxes beyond took the walks' chunk visits from
+    /// 29.0 M to 21.9 M and the rays skipped whole from 4.2 M to 6.0 M (of 17.2 M); the map
+    /// update 3 % faster in paired rounds. Seeds in line with the sensor instead of the faces'
+    /// centres skipped 4.6 M rays whole, boxes beyond grown along the face's axis first 5.7 M.
     pub fn grow(
         origin: IVec3,
         limit_lo: IVec3,
         limit_hi: IVec3,
         full: impl Fn(IVec3) -> bool,
     ) -> Self {
-        let mut boxes = [None; 3];
-        for (slot, first_axis) in [None, Some(0), Some(1)].into_iter().enumerate() {
+        let mut boxes = Self::default();
+        for first_axis in [None, Some(0), Some(1)] {
             let Some(grown) = FreeBox::grow(origin, limit_lo, limit_hi, first_axis, &full) else {
-                break;
+                return boxes;
             };
-            if !boxes.contains(&Some(grown)) {
-                boxes[slot] = Some(grown);
+            boxes.add(grown);
+        }
+        boxes.around = boxes.len;
+        let first = boxes.boxes[0];
+        let centre = (first.lo + first.hi) / 2;
+        for face in 0..6 {
+            let axis = face / 2;
+            let mut seed = centre;
+            seed[axis] = if face % 2 == 0 {
+                first.hi[axis] + 1
+            } else {
+                first.lo[axis] - 1
+            };
+            if (limit_lo[axis]..=limit_hi[axis]).contains(&seed[axis])
+                && let Some(grown) = FreeBox::grow(seed, limit_lo, limit_hi, None, &full)
+            {
+                boxes.add(grown);
             }
         }
-        Self(boxes)
+        boxes
     }
 
-    /// The boxes, the all-faces one first.
-    pub fn iter(&self) -> impl Iterator<Item = &FreeBox> {
-        self.0.iter().flatten()
+    /// Keeps `free` unless a box already kept equals it.
+    fn add(&mut self, free: FreeBox) {
+        if self.len < MAX_FREE_BOXES && !self.iter().any(|kept| *kept == free) {
+            self.boxes[self.len] = free;
+            self.len += 1;
+        }
     }
 
-    /// Whether one box holds both keys: then so does every key of a walk between them (a box
-    /// is convex, and each axis of a walk moves one way), and the walk changes nothing.
+    /// How many of the boxes (the first ones) lie around the sensor; the rest lie beyond the
+    /// faces of the first.
+    pub fn around(&self) -> usize {
+        self.around
+    }
+
+    /// The boxes, the all-faces one around the sensor first.
+    #[inline]
+    pub fn iter(&self) -> std::slice::Iter<'_, FreeBox> {
+        self.boxes[..self.len].iter()
+    }
+
+    /// Whether one of the boxes around the sensor holds both keys: then so does every key of a
+    /// walk between them (a box is convex, and each axis of a walk moves one way), and the walk
+    /// changes nothing. (Only those: every ray of a scan starts in them, and trying the boxes
+    /// beyond on every ray cost more than it found; a walk that a box beyond holds whole is
+    /// found as it leaves the ones around: `integrate`'s `leave_free_boxes`.)
     #[inline]
     pub fn hold(&self, start: IVec3, end: IVec3) -> bool {
-        self.iter().any(|b| b.contains(start) && b.contains(end))
+        self.boxes[..self.around]
+            .iter()
+            .any(|b| b.contains(start) && b.contains(end))
     }
 }
 

@@ -18,13 +18,14 @@ use super::cube::{Cube, CubeLimit, CubeMove, WalkInChunk, cross_saturated, leave
 use super::cursor::{CURSOR_X, CURSOR_Y, CURSOR_Z, Cursor};
 use super::dda::{T_ONE, VoxelWalk, to_fixed};
 use super::free_box::{FreeBox, FreeBoxes};
+use super::full_bricks::FullBricks;
 pub use super::rays::{HIT_NUDGE, ScanError, ScanRays};
 use super::rays::{PreparedRays, prepare};
 use super::update::{UpdateRule, update_voxel};
 use glam::{DVec3, IVec3};
 use uavex_components::map::{
-    BRICK_EDGE, CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig,
-    ScanId, StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
+    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, ChunkGrid, LogOddsIncrements, MapConfig, ScanId,
+    StatSums, StatTables, VoxelChunk, brick_of, floor_to_key, local_index,
 };
 
 /// Mutable access to the map's chunks, by flat chunk index (see [`ChunkGrid::flat`]).
@@ -69,6 +70,10 @@ pub struct ScanReport {
     pub free_box_rays: u64,
     /// Moves out of a free box (a ray may leave more than one).
     pub free_box_exits: u64,
+    /// Walks that reached a free box beyond the sensor's ([`FreeBoxes::grow`]), once per box:
+    /// each then ended in it or left it in one move (unless its face came within the end
+    /// margin).
+    pub free_box_beyond: u64,
 }
 
 /// Integrates one scan (common.md §1): see the module documentation. `totals` receives the
@@ -105,6 +110,7 @@ pub fn integrate_scan(
             ends,
             inverses,
             clips,
+            bricks,
         } = prepared;
         // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
         let hit_rule = rule(increments.hit);
@@ -121,7 +127,7 @@ pub fn integrate_scan(
         // misses only saturate more.
         let miss_rule = rule(increments.miss);
         let free_boxes = if miss_rule.delta <= 0 {
-            run.free_boxes(config, origin, ends)
+            run.free_boxes(config, origin, ends, bricks)
         } else {
             FreeBoxes::default()
         };
@@ -190,9 +196,15 @@ impl<C: ChunkAccess> Integration<'_, C> {
     }
 
     /// The scan's free boxes ([`FreeBoxes::grow`]) around the sensor at `origin` (voxel
-    /// units), within the key box of the rays' ends `ends`; none when the sensor is outside the
-    /// map.
-    fn free_boxes(&mut self, config: &MapConfig, origin: DVec3, ends: &[DVec3]) -> FreeBoxes {
+    /// units), within the key box of the rays' ends `ends`, grown on the bricks of that box
+    /// gathered into `bricks`; none when the sensor is outside the map.
+    fn free_boxes(
+        &mut self,
+        config: &MapConfig,
+        origin: DVec3,
+        ends: &[DVec3],
+        bricks: &mut FullBricks,
+    ) -> FreeBoxes {
         let origin_key = floor_to_key(origin);
         if !config.contains_key(origin_key) {
             return FreeBoxes::default();
@@ -203,15 +215,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
         });
         let lo = floor_to_key(lo).max(config.key_min());
         let hi = floor_to_key(hi).min(config.key_max());
-        let (grid, chunks) = (self.grid, &*self.chunks);
-        let boxes = FreeBoxes::grow(origin_key, lo, hi, |brick| {
-            let Some(flat) = grid.flat(ChunkCoord::of_key(brick * BRICK_EDGE)) else {
-                return false;
-            };
-            let local = brick & (CHUNK_EDGE / BRICK_EDGE - 1);
-            let bit = local.x + 4 * local.y + 16 * local.z;
-            chunks.full_bricks(flat) >> bit & 1 == 1
-        });
+        let chunks = &*self.chunks;
+        bricks.gather(self.grid, lo, hi, |flat| chunks.full_bricks(flat));
+        let boxes = FreeBoxes::grow(origin_key, lo, hi, |brick| bricks.is_full(brick));
         self.report.free_box_voxels = boxes
             .iter()
             .next()
@@ -220,7 +226,9 @@ impl<C: ChunkAccess> Integration<'_, C> {
     }
 
     /// Moves `walk` out of each of the scan's free boxes it is in, in turn
-    /// ([`Self::leave_free_box`]): the visits left, or `None` when it ends inside one.
+    /// ([`Self::leave_free_box`]): the visits left, or `None` when it ends inside one (all its
+    /// visits would change nothing). Once out of a box a walk never re-enters it (a box is
+    /// convex, and each axis of a walk moves one way).
     #[inline]
     fn leave_free_boxes(
         &mut self,
@@ -230,37 +238,36 @@ impl<C: ChunkAccess> Integration<'_, C> {
         t_safe: f64,
         mut visits: u64,
     ) -> Option<u64> {
-        for free in boxes.iter() {
+        for (index, free) in boxes.iter().enumerate() {
             if visits == 0 {
                 break;
             }
-            visits = self.leave_free_box(free, walk, end_key, t_safe, visits)?;
+            if !free.contains(walk.key()) {
+                continue;
+            }
+            self.report.free_box_beyond += u64::from(index >= boxes.around());
+            if free.contains(end_key) {
+                self.report.skipped_voxels += visits;
+                self.report.free_box_rays += 1;
+                return None;
+            }
+            visits = self.leave_free_box(free, walk, t_safe, visits);
         }
         Some(visits)
     }
 
-    /// Moves `walk` (with `visits` voxels to visit, its segment safe until `t_safe`) out of
-    /// the scan's free box in one move: the visits left, or `None` when the walk ends inside
-    /// the box (all its visits would change nothing). A walk that does not start in the box,
-    /// or leaves it only within the end margin, stays where it is.
+    /// Moves `walk` (in the scan's free box `free`, which does not hold its end; `visits`
+    /// voxels to visit, its segment safe until `t_safe`) out of the box in one move: the visits
+    /// left. A walk that leaves the box only within the end margin stays where it is.
     #[inline]
     fn leave_free_box(
         &mut self,
         free: &FreeBox,
         walk: &mut VoxelWalk,
-        end_key: IVec3,
         t_safe: f64,
         visits: u64,
-    ) -> Option<u64> {
+    ) -> u64 {
         let key = walk.key();
-        if !free.contains(key) {
-            return Some(visits);
-        }
-        if free.contains(end_key) {
-            self.report.skipped_voxels += visits;
-            self.report.free_box_rays += 1;
-            return None;
-        }
         let crossing = free.cross(
             key,
             walk.steps().map(i64::from),
@@ -268,7 +275,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             walk.boundary_intervals(),
         );
         if crossing.face_time >= to_fixed(t_safe) {
-            return Some(visits);
+            return visits;
         }
         // Every crossing is before `t_safe`: the voxels passed are on the walk, and the one
         // entered is too (unless it is a hit's excluded end voxel: then no visit is left).
@@ -280,7 +287,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let [mx, my, mz] = walk.steps();
         let moved = IVec3::new(kx as i32 * mx, ky as i32 * my, kz as i32 * mz);
         walk.resume(key + moved, crossing.boundary_times);
-        Some(visits - passed)
+        visits - passed
     }
 
     /// Updates the first `visits` voxels of `walk` (all inside the map), whose segment is safe

@@ -23,6 +23,7 @@ pub mod cube;
 mod cursor;
 pub mod dda;
 pub mod free_box;
+mod full_bricks;
 pub mod integrate;
 mod rays;
 pub mod read;

@@ -2,6 +2,7 @@
 //! what every ray needs before any walks, computed for all of them in one pass each.
 
 use super::dda::{ClippedSegment, SegmentClipper};
+use super::full_bricks::FullBricks;
 use glam::{DVec3, Vec3};
 use std::cell::RefCell;
 use uavex_components::map::MapConfig;
@@ -71,6 +72,8 @@ pub(super) struct PreparedRays<'a> {
     pub inverses: &'a [DVec3],
     /// Each ray clipped to the map's key box (`None` when it misses the map).
     pub clips: &'a [Option<ClippedSegment>],
+    /// Room for the scan's full bricks (`super::free_box`), kept from scan to scan.
+    pub bricks: &'a mut FullBricks,
 }
 
 /// Calls `f` with the rays of `rays` (valid: [`ScanRays::validate`]) prepared for `config`'s
@@ -89,6 +92,7 @@ pub(super) fn prepare<R>(
             ends,
             inverses,
             clips,
+            bricks,
         } = scratch;
         ends.clear();
         ends.extend(
@@ -107,6 +111,7 @@ pub(super) fn prepare<R>(
             ends,
             inverses,
             clips,
+            bricks,
         })
     })
 }
@@ -118,6 +123,7 @@ struct RayScratch {
     ends: Vec<DVec3>,
     inverses: Vec<DVec3>,
     clips: Vec<Option<ClippedSegment>>,
+    bricks: FullBricks,
 }
 
 thread_local! {

@@ -114,12 +114,20 @@ pub fn integrate_scan(
         } = prepared;
         // Pass 1: hits first, so that "occupied wins" over any miss of the same scan.
         let hit_rule = rule(increments.hit);
-        for (&end, _) in ends.iter().zip(rays.hit).filter(|&(_, &hit)| hit) {
-            let key = floor_to_key(end);
-            if config.contains_key(key) {
-                run.report.voxel_visits += 1;
-                run.update_one(key, hit_rule);
-            }
+        let mut hits = ends
+            .iter()
+            .zip(rays.hit)
+            .filter(|&(_, &hit)| hit)
+            .map(|(&end, _)| floor_to_key(end))
+            .filter(|&key| config.contains_key(key))
+            .peekable();
+        while let Some(key) = hits.next() {
+            // Neighbouring rays mostly end in one chunk: a run of them is one chunk visit.
+            let coord = ChunkCoord::of_key(key);
+            let in_chunk = std::iter::once(key).chain(std::iter::from_fn(|| {
+                hits.next_if(|&next| ChunkCoord::of_key(next) == coord)
+            }));
+            run.report.voxel_visits += run.update_in_chunk(coord, in_chunk, hit_rule);
         }
 
         // Pass 2: free space along every ray, skipping voxels this scan already updated. The
@@ -176,23 +184,40 @@ struct Integration<'a, C> {
 impl<C: ChunkAccess> Integration<'_, C> {
     /// Updates the single voxel `key` (inside the map).
     fn update_one(&mut self, key: IVec3, rule: UpdateRule) {
-        let coord = ChunkCoord::of_key(key);
+        self.update_in_chunk(ChunkCoord::of_key(key), std::iter::once(key), rule);
+    }
+
+    /// Updates the voxels `keys`, all inside the map and in the chunk at `coord`, in one visit
+    /// of the chunk: how many there were.
+    #[inline]
+    fn update_in_chunk(
+        &mut self,
+        coord: ChunkCoord,
+        keys: impl Iterator<Item = IVec3>,
+        rule: UpdateRule,
+    ) -> u64 {
         let flat = self.grid.flat_unchecked(coord);
         let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
         chunk.begin_scan(self.scan);
         let before = *stats;
         let (voxels, saturation) = chunk.voxels_and_saturation_mut();
-        let index = local_index(key) & (CHUNK_VOXELS - 1);
-        let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
-        if change.state_changed() {
-            chunk.note_state_changes_in(self.scan, 1 << brick_of(index));
+        let (mut visits, mut changed, mut state_bricks) = (0, 0, 0u64);
+        for key in keys {
+            debug_assert_eq!(ChunkCoord::of_key(key), coord);
+            let index = local_index(key) & (CHUNK_VOXELS - 1);
+            let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
+            visits += 1;
+            changed += u64::from(change.changed());
+            state_bricks |= u64::from(change.state_changed()) << brick_of(index);
         }
-        if change.changed() {
-            // A voxel's statistics change only with its log-odds.
+        chunk.note_state_changes_in(self.scan, state_bricks);
+        if changed > 0 {
+            // Statistics change only with log-odds.
             self.totals.add_change(&before, stats);
-            self.report.changed_voxels += 1;
+            self.report.changed_voxels += changed;
             self.chunks.mark_written(flat);
         }
+        visits
     }
 
     /// The scan's free boxes ([`FreeBoxes::grow`]) around the sensor at `origin` (voxel

@@ -40,3 +40,5 @@ pub use system::{MappingScratch, insert_map_resources, integrate_scans};
 
 #[cfg(test)]
 pub(crate) mod tests;
+#[cfg(test)]
+mod tests_plain;

@@ -14,7 +14,7 @@
 //!
 //! The map that results is the same bit for bit. A box is grown greedily, one brick layer per
 //! face in turn (+x, -x, +y, -y, +z, -z), while the new layer's bricks are all full: not the
-//! largest box there is, but deterministic and cheap (a bit test per brick, on the scan's
+//! largest box there is, but deterministic and cheap (a few bit tests per layer, on the scan's
 //! `super::full_bricks::FullBricks`). One brick that is not full stops a face across the
 //! whole box, so [`FreeBoxes`] also grows two boxes that take x, or y, to the end first and
 //! then the rest: along a free corridor or the length of a room they reach farther, and a ray
@@ -42,19 +42,20 @@ const BRICK_SHIFT: i32 = BRICK_EDGE.trailing_zeros() as i32;
 
 impl FreeBox {
     /// The box grown from the brick of `origin` (a key) within the bricks that meet the key box
-    /// `limit_lo..=limit_hi`, where `full(brick)` tells whether a brick (by brick coordinates,
-    /// key / 4) is full of saturated free voxels: the faces of `first_axis` first, while they
-    /// can grow, then all faces in turn. `None` when the origin's brick is not full.
+    /// `limit_lo..=limit_hi`, where `all_full(lo, hi)` tells whether the bricks `lo..=hi` (by
+    /// brick coordinates, key / 4) are all full of saturated free voxels: the faces of
+    /// `first_axis` first, while they can grow, then all faces in turn. `None` when the
+    /// origin's brick is not full.
     pub fn grow(
         origin: IVec3,
         limit_lo: IVec3,
         limit_hi: IVec3,
         first_axis: Option<usize>,
-        mut full: impl FnMut(IVec3) -> bool,
+        all_full: impl Fn(IVec3, IVec3) -> bool,
     ) -> Option<Self> {
         let (limit_lo, limit_hi) = (limit_lo >> BRICK_SHIFT, limit_hi >> BRICK_SHIFT);
         let start = origin >> BRICK_SHIFT;
-        if !full(start) {
+        if !all_full(start, start) {
             return None;
         }
         let (mut lo, mut hi) = (start, start);
@@ -83,7 +84,7 @@ impl FreeBox {
                     } else {
                         layer >= limit_lo[axis]
                     };
-                    if inside && all_bricks(from, to, &mut full) {
+                    if inside && all_full(from, to) {
                         if up {
                             hi[axis] = layer;
                         } else {
@@ -163,7 +164,7 @@ impl Default for FreeBoxes {
 
 impl FreeBoxes {
     /// The boxes of a scan whose sensor is at key `origin`, within the bricks that meet the
-    /// key box `limit_lo..=limit_hi` (`full` as for [`FreeBox::grow`]); none when the origin's
+    /// key box `limit_lo..=limit_hi` (`all_full` as for [`FreeBox::grow`]); none when the origin's
     /// brick is not full:
     /// - around the sensor, the box grown with all faces in turn, then those grown x first and
     ///   y first (each only if it differs from the ones before);
@@ -180,11 +181,12 @@ impl FreeBoxes {
         origin: IVec3,
         limit_lo: IVec3,
         limit_hi: IVec3,
-        full: impl Fn(IVec3) -> bool,
+        all_full: impl Fn(IVec3, IVec3) -> bool,
     ) -> Self {
         let mut boxes = Self::default();
         for first_axis in [None, Some(0), Some(1)] {
-            let Some(grown) = FreeBox::grow(origin, limit_lo, limit_hi, first_axis, &full) else {
+            let Some(grown) = FreeBox::grow(origin, limit_lo, limit_hi, first_axis, &all_full)
+            else {
                 return boxes;
             };
             boxes.add(grown);
@@ -205,7 +207,7 @@ impl FreeBoxes {
                 if !(limit_lo[axis]..=limit_hi[axis]).contains(&seed[axis]) {
                     break;
                 }
-                let Some(grown) = FreeBox::grow(seed, limit_lo, limit_hi, None, &full) else {
+                let Some(grown) = FreeBox::grow(seed, limit_lo, limit_hi, None, &all_full) else {
                     break;
                 };
                 boxes.add(grown);
@@ -248,18 +250,21 @@ impl FreeBoxes {
     }
 }
 
-/// Whether every brick of `from..=to` is full.
-fn all_bricks(from: IVec3, to: IVec3, full: &mut impl FnMut(IVec3) -> bool) -> bool {
-    (from.z..=to.z)
-        .all(|z| (from.y..=to.y).all(|y| (from.x..=to.x).all(|x| full(IVec3::new(x, y, z)))))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::mapping::cube::tests::step_by_voxel_until;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
+
+    /// The box test [`FreeBox::grow`] takes, from a test of one brick.
+    fn each_brick(full: impl Fn(IVec3) -> bool) -> impl Fn(IVec3, IVec3) -> bool {
+        move |from, to| {
+            (from.z..=to.z).all(|z| {
+                (from.y..=to.y).all(|y| (from.x..=to.x).all(|x| full(IVec3::new(x, y, z))))
+            })
+        }
+    }
 
     #[test]
     fn grows_until_a_brick_that_is_not_full_on_every_side() {
@@ -275,7 +280,7 @@ mod tests {
             IVec3::splat(-100),
             IVec3::splat(100),
             None,
-            full,
+            each_brick(full),
         )
         .expect("the origin's brick is full");
         // By hand, face by face (+x, -x, +y, -y; z never grows): round 1 takes x = 1, x = -1,
@@ -296,7 +301,7 @@ mod tests {
             IVec3::new(1, 2, 3),
             IVec3::splat(-100),
             IVec3::splat(100),
-            full,
+            each_brick(full),
         );
         let boxes: Vec<_> = boxes.iter().map(|b| (b.lo, b.hi)).collect();
         assert_eq!(
@@ -311,14 +316,22 @@ mod tests {
     #[test]
     fn no_box_when_the_origin_brick_is_not_full_and_none_beyond_the_limits() {
         assert_eq!(
-            FreeBox::grow(IVec3::ZERO, IVec3::splat(-9), IVec3::splat(9), None, |_| {
-                false
-            }),
+            FreeBox::grow(
+                IVec3::ZERO,
+                IVec3::splat(-9),
+                IVec3::splat(9),
+                None,
+                |_, _| { false }
+            ),
             None
         );
-        let free = FreeBox::grow(IVec3::ZERO, IVec3::splat(-5), IVec3::splat(9), None, |_| {
-            true
-        })
+        let free = FreeBox::grow(
+            IVec3::ZERO,
+            IVec3::splat(-5),
+            IVec3::splat(9),
+            None,
+            |_, _| true,
+        )
         .expect("all full");
         // Keys -5..=9 meet bricks -2..=2.
         assert_eq!((free.lo, free.hi), (IVec3::splat(-8), IVec3::splat(11)));

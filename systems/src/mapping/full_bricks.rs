@@ -71,8 +71,8 @@ impl FullBricks {
     }
 
     /// Whether `brick` (brick coordinates: key / [`BRICK_EDGE`]) is full; `false` outside the
-    /// grid.
-    #[inline]
+    /// grid. (The tests' reference for [`Self::all_full`].)
+    #[cfg(test)]
     pub fn is_full(&self, brick: IVec3) -> bool {
         let r = brick - self.lo;
         if r.cmplt(IVec3::ZERO).any() || r.cmpge(self.dims).any() {
@@ -80,6 +80,37 @@ impl FullBricks {
         }
         let bit = (r.x + self.dims.x * (r.y + self.dims.y * r.z)) as usize;
         self.words[bit / 64] >> (bit % 64) & 1 == 1
+    }
+
+    /// Whether every brick of `lo..=hi` (brick coordinates) is full: a row of bricks along x
+    /// is a run of bits, tested a word at a time. `false` if any lies outside the grid; `true`
+    /// for an empty box.
+    pub fn all_full(&self, lo: IVec3, hi: IVec3) -> bool {
+        if lo.cmpgt(hi).any() {
+            return true;
+        }
+        let (r0, r1) = (lo - self.lo, hi - self.lo);
+        if r0.cmplt(IVec3::ZERO).any() || r1.cmpge(self.dims).any() {
+            return false;
+        }
+        let run = (r1.x - r0.x) as usize;
+        (r0.z..=r1.z).all(|z| {
+            (r0.y..=r1.y).all(|y| {
+                let first = (r0.x + self.dims.x * (y + self.dims.y * z)) as usize;
+                self.all_set(first, first + run)
+            })
+        })
+    }
+
+    /// Whether bits `first..=last` are all set.
+    #[inline]
+    fn all_set(&self, first: usize, last: usize) -> bool {
+        (first / 64..=last / 64).all(|word| {
+            let from = if word == first / 64 { first % 64 } else { 0 };
+            let to = if word == last / 64 { last % 64 } else { 63 };
+            let mask = (u64::MAX >> (63 - to)) & (u64::MAX << from);
+            self.words[word] & mask == mask
+        })
     }
 }
 
@@ -139,6 +170,69 @@ mod tests {
                 set > 300,
                 "only {set} full bricks: the test would show little"
             );
+        }
+    }
+
+    /// A box of bricks is all full exactly when each of its bricks is, whatever the words its
+    /// rows straddle (rows of 12 bits here); a box reaching past the grid is not.
+    #[test]
+    fn a_box_is_full_when_every_brick_of_it_is() {
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        // Mostly full, so that many boxes are full too.
+        let (grid, full) = grid_and_bricks(&mut rng, 0.9);
+        let mut bricks = FullBricks::default();
+        // Chunks -1..=1 on x: rows of 12 bricks, across word boundaries.
+        bricks.gather(
+            grid,
+            IVec3::new(-16, -16, 0),
+            IVec3::new(31, 15, 31),
+            |flat| full[flat],
+        );
+        assert_eq!(bricks.dims, IVec3::new(12, 8, 8));
+        let (mut full_boxes, mut open_boxes) = (0, 0);
+        for _ in 0..50_000 {
+            let lo = IVec3::new(
+                rng.random_range(-5..12),
+                rng.random_range(-5..4),
+                rng.random_range(-1..8),
+            );
+            let hi = lo + IVec3::from_array([0; 3].map(|_| rng.random_range(0..5)));
+            let expected = (lo.z..=hi.z).all(|z| {
+                (lo.y..=hi.y).all(|y| (lo.x..=hi.x).all(|x| bricks.is_full(IVec3::new(x, y, z))))
+            });
+            assert_eq!(bricks.all_full(lo, hi), expected, "{lo}..={hi}");
+            if expected {
+                full_boxes += 1;
+            } else {
+                open_boxes += 1;
+            }
+        }
+        assert!(
+            full_boxes > 1000 && open_boxes > 1000,
+            "{full_boxes} full, {open_boxes} not"
+        );
+        // An empty box holds no brick that is not full.
+        assert!(bricks.all_full(IVec3::new(3, 0, 0), IVec3::new(2, 0, 0)));
+
+        // Exhaustively, one brick not full in a full grid (rows of 12 bits, some across two
+        // words): every row through it is not full, the rest of the row on either side is.
+        let dims = IVec3::new(12, 8, 8);
+        let mut one_open = FullBricks {
+            lo: IVec3::ZERO,
+            dims,
+            words: vec![u64::MAX; 12],
+        };
+        for bit in 0..(dims.element_product() as usize) {
+            one_open.words[bit / 64] &= !(1 << (bit % 64));
+            let brick = IVec3::new(bit as i32 % 12, bit as i32 / 12 % 8, bit as i32 / 96);
+            let row = |from: i32, to: i32| (brick.with_x(from), brick.with_x(to));
+            let (lo, hi) = row(0, 11);
+            assert!(!one_open.all_full(lo, hi), "{brick}");
+            let (lo, hi) = row(0, brick.x - 1);
+            assert!(one_open.all_full(lo, hi), "left of {brick}");
+            let (lo, hi) = row(brick.x + 1, 11);
+            assert!(one_open.all_full(lo, hi), "right of {brick}");
+            one_open.words[bit / 64] = u64::MAX;
         }
     }
 }

@@ -242,7 +242,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let hi = floor_to_key(hi).min(config.key_max());
         let chunks = &*self.chunks;
         bricks.gather(self.grid, lo, hi, |flat| chunks.full_bricks(flat));
-        let boxes = FreeBoxes::grow(origin_key, lo, hi, |brick| bricks.is_full(brick));
+        let boxes = FreeBoxes::grow(origin_key, lo, hi, |from, to| bricks.all_full(from, to));
         self.report.free_box_voxels = boxes
             .iter()
             .next()

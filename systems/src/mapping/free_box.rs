@@ -164,8 +164,8 @@ impl Default for FreeBoxes {
 
 impl FreeBoxes {
     /// The boxes of a scan whose sensor is at key `origin`, within the bricks that meet the
-    /// key box `limit_lo..=limit_hi` (`all_full` as for [`FreeBox::grow`]); none when the origin's
-    /// brick is not full:
+    /// key box `limit_lo..=limit_hi` (`all_full` as for [`FreeBox::grow`]); none when the
+    /// origin's brick is not full:
     /// - around the sensor, the box grown with all faces in turn, then those grown x first and
     ///   y first (each only if it differs from the ones before);
     /// - beyond each face of the first one, a chain of [`CHAIN`] boxes, each grown with all
@@ -175,8 +175,9 @@ impl FreeBoxes {
     /// In the shipped Pillars mission the boxes beyond took the walks' chunk visits from
     /// 29.0 M to 20.9 M and the rays skipped whole from 4.2 M to 6.4 M (of 17.2 M); the map
     /// update 3 % faster in paired rounds (a chain of two against one box per face: 0-1.5 %, a
-    /// chain of three no faster than two). Seeds in line with the sensor instead of the faces' centres skipped
-    /// 4.6 M rays whole with one box per face, boxes grown along the face's axis first 5.7 M.
+    /// chain of three no faster than two). Seeds in line with the sensor instead of the faces'
+    /// centres skipped 4.6 M rays whole with one box per face, boxes grown along the face's
+    /// axis first 5.7 M.
     pub fn grow(
         origin: IVec3,
         limit_lo: IVec3,

@@ -68,12 +68,12 @@ impl BucketQueue {
 /// hundred cells of a lattice of ~200,000).
 ///
 /// The relaxation of a move reads the target cell's mark and cost, which share one word (the
-/// cost in the low [`COST_BITS`], the mark above): the search is bound by the latency of
+/// cost in the low [`Word::COST_BITS`], the mark above): the search is bound by the latency of
 /// these reads, scattered over the lattice, so the words are kept as small as they can be
-/// (8 bytes per cell, 1.5 MB for a Pillars map) and the arrivals, written only when a cost
-/// improves, apart.
-pub(super) struct Nodes {
-    words: Vec<u64>,
+/// ([`Word`]: 4 bytes per cell, 0.75 MB for a Pillars map) and the arrivals, written only when
+/// a cost improves, apart.
+pub(super) struct Nodes<W> {
+    words: Vec<W>,
     /// The move by which each reached cell was reached at its cost (its parent is the cell
     /// that move came from), or [`START`].
     arrivals: Vec<u8>,
@@ -81,18 +81,71 @@ pub(super) struct Nodes {
     reached: u64,
 }
 
-/// Bits of a cell's word that hold its cost. A reached cell's cost is at most that of a
-/// shortest path through every lattice cell plus one move, below `2^41`.
-const COST_BITS: u32 = 42;
-const COST_MASK: u64 = (1 << COST_BITS) - 1;
-const _: () = assert!(MAX_LATTICE_CELLS.saturating_mul(MOVE_COSTS[2]) < COST_MASK);
+/// A cell's word: its cost in the low [`Self::COST_BITS`], its mark above. A reached cell's
+/// cost is at most that of a shortest path through every lattice cell plus one move, below
+/// `cells x MOVE_COSTS[2]`: lattices for which that bound fits in a `u32`'s cost bits (up to
+/// ~310,000 cells, the EAAE scenes' ~190,000-220,000) use `u32` words, larger ones `u64`.
+/// (Half the bytes: `find_paths/40_goals` of benches/planning.rs 12-27 % faster on a 2-core
+/// AMD EPYC with 512 KB of L2 per core, where the 1.5 MB of `u64` words did not fit.)
+pub(super) trait Word: Copy + Default {
+    /// Bits of the word that hold the cost; the rest hold the mark.
+    const COST_BITS: u32;
+    /// Bits of the word.
+    const BITS: u32;
+    fn get(self) -> u64;
+    /// The word of `bits` (below `2^BITS`).
+    fn of(bits: u64) -> Self;
+}
 
-impl Nodes {
+impl Word for u32 {
+    /// Three bits of mark: three searches between clearings.
+    const COST_BITS: u32 = 29;
+    const BITS: u32 = 32;
+    #[inline(always)]
+    fn get(self) -> u64 {
+        u64::from(self)
+    }
+    #[inline(always)]
+    fn of(bits: u64) -> Self {
+        bits as u32
+    }
+}
+
+impl Word for u64 {
+    const COST_BITS: u32 = 42;
+    const BITS: u32 = 64;
+    #[inline(always)]
+    fn get(self) -> u64 {
+        self
+    }
+    #[inline(always)]
+    fn of(bits: u64) -> Self {
+        bits
+    }
+}
+const _: () = assert!(MAX_LATTICE_CELLS.saturating_mul(MOVE_COSTS[2]) < 1 << u64::COST_BITS);
+
+/// Whether a lattice of `cells` cells can use `u32` words ([`Word`]).
+fn narrow_words(cells: usize) -> bool {
+    (cells as u64).saturating_mul(MOVE_COSTS[2]) < 1 << u32::COST_BITS
+}
+
+impl<W: Word> Nodes<W> {
+    const COST_MASK: u64 = (1 << W::COST_BITS) - 1;
+
+    fn new() -> Self {
+        Self {
+            words: Vec::new(),
+            arrivals: Vec::new(),
+            reached: 0,
+        }
+    }
+
     /// Starts a search over `len` cells: none reached.
     fn begin(&mut self, len: usize) {
-        if self.words.len() != len || self.reached + 2 >= 1 << (64 - COST_BITS) {
+        if self.words.len() != len || self.reached + 2 >= 1 << (W::BITS - W::COST_BITS) {
             self.words.clear();
-            self.words.resize(len, 0);
+            self.words.resize(len, W::default());
             self.arrivals.clear();
             self.arrivals.resize(len, START);
             self.reached = 0;
@@ -103,19 +156,20 @@ impl Nodes {
     /// The smallest word of a cell reached by this search.
     #[inline]
     fn reached_base(&self) -> u64 {
-        self.reached << COST_BITS
+        self.reached << W::COST_BITS
     }
 
     #[inline]
-    pub(super) fn cost(&self, cell: usize) -> u64 {
+    fn cost(&self, cell: usize) -> u64 {
         Self::cost_of(self.words[cell], self.reached_base())
     }
 
     /// The cost a cell's `word` holds, given the search's [`Self::reached_base`].
     #[inline]
-    fn cost_of(word: u64, base: u64) -> u64 {
+    fn cost_of(word: W, base: u64) -> u64 {
+        let word = word.get();
         if word >= base {
-            word & COST_MASK
+            word & Self::COST_MASK
         } else {
             u64::MAX
         }
@@ -124,20 +178,20 @@ impl Nodes {
     /// The move that reached `cell` (a cell reached by this search), none for the start.
     #[inline]
     fn arrival(&self, cell: usize) -> Option<usize> {
-        debug_assert!(self.words[cell] >= self.reached_base());
+        debug_assert!(self.words[cell].get() >= self.reached_base());
         let arrival = self.arrivals[cell];
         (arrival != START).then_some(usize::from(arrival))
     }
 
     #[inline]
-    pub(super) fn is_closed(&self, cell: usize) -> bool {
-        self.words[cell] >> COST_BITS == self.reached + 1
+    fn is_closed(&self, cell: usize) -> bool {
+        self.words[cell].get() >> W::COST_BITS == self.reached + 1
     }
 
     #[inline]
     fn close(&mut self, cell: usize) {
         let word = &mut self.words[cell];
-        *word = (*word & COST_MASK) | (self.reached + 1) << COST_BITS;
+        *word = W::of((word.get() & Self::COST_MASK) | (self.reached + 1) << W::COST_BITS);
     }
 
     #[inline]
@@ -148,8 +202,8 @@ impl Nodes {
     /// [`Self::reach`] given the search's [`Self::reached_base`].
     #[inline]
     fn reach_with(&mut self, cell: usize, cost: u64, arrival: u8, base: u64) {
-        debug_assert!(cost <= COST_MASK);
-        self.words[cell] = base | cost;
+        debug_assert!(cost <= Self::COST_MASK);
+        self.words[cell] = W::of(base | cost);
         self.arrivals[cell] = arrival;
     }
 }
@@ -222,18 +276,17 @@ const REACH_FROM_ARRIVAL: [u32; 26] = {
 
 /// What a thread keeps between searches.
 struct Scratch {
-    nodes: Nodes,
+    /// The cells of lattices small enough for `u32` words ([`Word`]), and of the others.
+    narrow: Nodes<u32>,
+    wide: Nodes<u64>,
     queue: BucketQueue,
 }
 
 impl Scratch {
     fn new() -> Self {
         Self {
-            nodes: Nodes {
-                words: Vec::new(),
-                arrivals: Vec::new(),
-                reached: 0,
-            },
+            narrow: Nodes::new(),
+            wide: Nodes::new(),
             queue: BucketQueue::new(),
         }
     }
@@ -250,6 +303,13 @@ thread_local! {
 /// reachable space is exhausted, or more than `max_expansions` cells were expanded.
 pub(super) struct Search<const ASTAR: bool> {
     scratch: Option<Scratch>,
+    /// Whether the cells are in the scratch's `u64` words (a large lattice, see [`Word`]).
+    wide: bool,
+    state: RunState,
+}
+
+/// Where a [`Search`] stands between runs.
+struct RunState {
     target: IVec3,
     max_expansions: usize,
     expansions: usize,
@@ -267,21 +327,43 @@ impl<const ASTAR: bool> Search<ASTAR> {
         target: IVec3,
         max_expansions: usize,
     ) -> Self {
+        let wide = !narrow_words(lattice.len());
+        Self::with_words(lattice, start, target, max_expansions, wide)
+    }
+
+    /// [`Self::new`] on `u64` words if `wide`, else on `u32` ones (which the lattice must
+    /// allow: [`narrow_words`]).
+    fn with_words(
+        lattice: &Lattice,
+        start: usize,
+        target: IVec3,
+        max_expansions: usize,
+        wide: bool,
+    ) -> Self {
+        debug_assert!(wide || narrow_words(lattice.len()));
         let mut scratch = SCRATCH
             .with_borrow_mut(Option::take)
             .unwrap_or_else(Scratch::new);
-        let Scratch { nodes, queue } = &mut scratch;
-        nodes.begin(lattice.len());
-        nodes.reach(start, 0, START);
+        if wide {
+            scratch.wide.begin(lattice.len());
+            scratch.wide.reach(start, 0, START);
+        } else {
+            scratch.narrow.begin(lattice.len());
+            scratch.narrow.reach(start, 0, START);
+        }
+        let queue = &mut scratch.queue;
         queue.reset(Self::heuristic(lattice.cell(start), target));
         queue.push(queue.current, start);
         Self {
             scratch: Some(scratch),
-            target,
-            max_expansions,
-            expansions: 0,
-            unexpanded: None,
-            done: false,
+            wide,
+            state: RunState {
+                target,
+                max_expansions,
+                expansions: 0,
+                unexpanded: None,
+                done: false,
+            },
         }
     }
 
@@ -295,27 +377,65 @@ impl<const ASTAR: bool> Search<ASTAR> {
 
     /// Cells expanded so far (at most `max_expansions`).
     pub(super) fn expansions(&self) -> usize {
-        self.expansions.min(self.max_expansions)
+        self.state.expansions.min(self.state.max_expansions)
     }
 
-    /// The cells' state.
-    pub(super) fn nodes(&self) -> &Nodes {
-        &self.scratch.as_ref().expect("held until dropped").nodes
+    fn scratch(&self) -> &Scratch {
+        self.scratch.as_ref().expect("held until dropped")
+    }
+
+    /// Whether `cell` is closed: its cost is final.
+    pub(super) fn is_closed(&self, cell: usize) -> bool {
+        let scratch = self.scratch();
+        if self.wide {
+            scratch.wide.is_closed(cell)
+        } else {
+            scratch.narrow.is_closed(cell)
+        }
+    }
+
+    /// The cost of `cell` so far (`u64::MAX` if not reached).
+    #[cfg(test)]
+    fn cost(&self, cell: usize) -> u64 {
+        let scratch = self.scratch();
+        if self.wide {
+            scratch.wide.cost(cell)
+        } else {
+            scratch.narrow.cost(cell)
+        }
     }
 
     /// Closes cells in order of cost, calling `settled` on each as it is closed, until it
     /// returns true (that cell is left unexpanded until the next run), the reachable space is
     /// exhausted, or more than `max_expansions` cells were expanded (over all runs).
-    pub(super) fn run(&mut self, lattice: &Lattice, mut settled: impl FnMut(usize) -> bool) {
-        let Self {
-            scratch,
+    pub(super) fn run(&mut self, lattice: &Lattice, settled: impl FnMut(usize) -> bool) {
+        let Scratch {
+            narrow,
+            wide,
+            queue,
+        } = self.scratch.as_mut().expect("held until dropped");
+        if self.wide {
+            Self::run_on(lattice, wide, queue, &mut self.state, settled);
+        } else {
+            Self::run_on(lattice, narrow, queue, &mut self.state, settled);
+        }
+    }
+
+    /// [`Self::run`] on the search's cells.
+    fn run_on<W: Word>(
+        lattice: &Lattice,
+        nodes: &mut Nodes<W>,
+        queue: &mut BucketQueue,
+        state: &mut RunState,
+        mut settled: impl FnMut(usize) -> bool,
+    ) {
+        let RunState {
             target,
             max_expansions,
             expansions,
             unexpanded,
             done,
-        } = self;
-        let Scratch { nodes, queue } = scratch.as_mut().expect("held until dropped");
+        } = state;
         let mut next = unexpanded.take();
         while !*done {
             let index = match next.take() {
@@ -341,13 +461,21 @@ impl<const ASTAR: bool> Search<ASTAR> {
                 *done = true;
                 return;
             }
-            expand::<ASTAR>(lattice, nodes, queue, index, *target);
+            expand::<ASTAR, W>(lattice, nodes, queue, index, *target);
         }
     }
 
     /// Cells from the start to `goal` (closed) by following the arrivals back.
     pub(super) fn trace(&self, moves: &[Move], goal: usize) -> Vec<usize> {
-        let nodes = self.nodes();
+        let scratch = self.scratch();
+        if self.wide {
+            Self::trace_on(&scratch.wide, moves, goal)
+        } else {
+            Self::trace_on(&scratch.narrow, moves, goal)
+        }
+    }
+
+    fn trace_on<W: Word>(nodes: &Nodes<W>, moves: &[Move], goal: usize) -> Vec<usize> {
         let mut cells = vec![goal];
         let mut at = goal;
         while let Some(arrival) = nodes.arrival(at) {
@@ -373,9 +501,9 @@ impl<const ASTAR: bool> Drop for Search<ASTAR> {
 
 /// Relaxes the moves out of the closed cell `index`.
 #[inline(always)]
-fn expand<const ASTAR: bool>(
+fn expand<const ASTAR: bool, W: Word>(
     lattice: &Lattice,
-    nodes: &mut Nodes,
+    nodes: &mut Nodes<W>,
     queue: &mut BucketQueue,
     index: usize,
     target: IVec3,
@@ -402,7 +530,7 @@ fn expand<const ASTAR: bool>(
         let next = index.wrapping_add_signed(mv.offset);
         let g_next = g + mv.cost;
         // A closed cell already has a cost <= g (consistent heuristic): no closed check.
-        if g_next < Nodes::cost_of(nodes.words[next], base) {
+        if g_next < Nodes::<W>::cost_of(nodes.words[next], base) {
             nodes.reach_with(next, g_next, k as u8, base);
             queue.push(
                 g_next + Search::<ASTAR>::heuristic(cell + mv.delta, target),
@@ -412,11 +540,24 @@ fn expand<const ASTAR: bool>(
     }
 }
 
+/// The cost of every cell from `start` (`u64::MAX` where unreached), by a Dijkstra on `u64`
+/// words if `wide`, else on `u32` ones.
 #[cfg(test)]
-pub(super) fn all_costs(lattice: &Lattice, start: usize) -> Vec<u64> {
-    let mut search = Search::<false>::new(lattice, start, IVec3::ZERO, usize::MAX);
+pub(super) fn all_costs(lattice: &Lattice, start: usize, wide: bool) -> Vec<u64> {
+    let mut search = Search::<false>::with_words(lattice, start, IVec3::ZERO, usize::MAX, wide);
     search.run(lattice, |_| false);
-    (0..lattice.len())
-        .map(|cell| search.nodes().cost(cell))
-        .collect()
+    (0..lattice.len()).map(|cell| search.cost(cell)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn narrow_words_hold_any_cost_of_the_lattices_they_are_used_for() {
+        // 2^29 / 1732 = 309,971.6 cells.
+        assert!(narrow_words(309_971));
+        assert!(!narrow_words(309_972));
+        assert!(!narrow_words(usize::MAX));
+    }
 }

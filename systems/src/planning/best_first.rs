@@ -159,11 +159,6 @@ impl<W: Word> Nodes<W> {
         self.reached << W::COST_BITS
     }
 
-    #[inline]
-    fn cost(&self, cell: usize) -> u64 {
-        Self::cost_of(self.words[cell], self.reached_base())
-    }
-
     /// The cost a cell's `word` holds, given the search's [`Self::reached_base`].
     #[inline]
     fn cost_of(word: W, base: u64) -> u64 {
@@ -173,19 +168,6 @@ impl<W: Word> Nodes<W> {
         } else {
             u64::MAX
         }
-    }
-
-    /// The move that reached `cell` (a cell reached by this search), none for the start.
-    #[inline]
-    fn arrival(&self, cell: usize) -> Option<usize> {
-        debug_assert!(self.words[cell].get() >= self.reached_base());
-        let arrival = self.arrivals[cell];
-        (arrival != START).then_some(usize::from(arrival))
-    }
-
-    #[inline]
-    fn is_closed(&self, cell: usize) -> bool {
-        self.words[cell].get() >> W::COST_BITS == self.reached + 1
     }
 
     #[inline]
@@ -205,6 +187,36 @@ impl<W: Word> Nodes<W> {
         debug_assert!(cost <= Self::COST_MASK);
         self.words[cell] = W::of(base | cost);
         self.arrivals[cell] = arrival;
+    }
+}
+
+/// What is read of a search's cells, whatever the width of their words: the search itself
+/// reads [`Nodes`] of one width directly, the callers through [`Search::nodes`].
+pub(super) trait Cells {
+    /// The cost of `cell` so far (`u64::MAX` if not reached by this search).
+    fn cost(&self, cell: usize) -> u64;
+    /// The move that reached `cell` (a cell reached by this search), none for the start.
+    fn arrival(&self, cell: usize) -> Option<usize>;
+    /// Whether `cell` is closed: its cost is final.
+    fn is_closed(&self, cell: usize) -> bool;
+}
+
+impl<W: Word> Cells for Nodes<W> {
+    #[inline]
+    fn cost(&self, cell: usize) -> u64 {
+        Self::cost_of(self.words[cell], self.reached_base())
+    }
+
+    #[inline]
+    fn arrival(&self, cell: usize) -> Option<usize> {
+        debug_assert!(self.words[cell].get() >= self.reached_base());
+        let arrival = self.arrivals[cell];
+        (arrival != START).then_some(usize::from(arrival))
+    }
+
+    #[inline]
+    fn is_closed(&self, cell: usize) -> bool {
+        self.words[cell].get() >> W::COST_BITS == self.reached + 1
     }
 }
 
@@ -380,28 +392,13 @@ impl<const ASTAR: bool> Search<ASTAR> {
         self.state.expansions.min(self.state.max_expansions)
     }
 
-    fn scratch(&self) -> &Scratch {
-        self.scratch.as_ref().expect("held until dropped")
-    }
-
-    /// Whether `cell` is closed: its cost is final.
-    pub(super) fn is_closed(&self, cell: usize) -> bool {
-        let scratch = self.scratch();
+    /// The cells' state.
+    pub(super) fn nodes(&self) -> &dyn Cells {
+        let scratch = self.scratch.as_ref().expect("held until dropped");
         if self.wide {
-            scratch.wide.is_closed(cell)
+            &scratch.wide
         } else {
-            scratch.narrow.is_closed(cell)
-        }
-    }
-
-    /// The cost of `cell` so far (`u64::MAX` if not reached).
-    #[cfg(test)]
-    fn cost(&self, cell: usize) -> u64 {
-        let scratch = self.scratch();
-        if self.wide {
-            scratch.wide.cost(cell)
-        } else {
-            scratch.narrow.cost(cell)
+            &scratch.narrow
         }
     }
 
@@ -467,15 +464,7 @@ impl<const ASTAR: bool> Search<ASTAR> {
 
     /// Cells from the start to `goal` (closed) by following the arrivals back.
     pub(super) fn trace(&self, moves: &[Move], goal: usize) -> Vec<usize> {
-        let scratch = self.scratch();
-        if self.wide {
-            Self::trace_on(&scratch.wide, moves, goal)
-        } else {
-            Self::trace_on(&scratch.narrow, moves, goal)
-        }
-    }
-
-    fn trace_on<W: Word>(nodes: &Nodes<W>, moves: &[Move], goal: usize) -> Vec<usize> {
+        let nodes = self.nodes();
         let mut cells = vec![goal];
         let mut at = goal;
         while let Some(arrival) = nodes.arrival(at) {
@@ -546,7 +535,9 @@ fn expand<const ASTAR: bool, W: Word>(
 pub(super) fn all_costs(lattice: &Lattice, start: usize, wide: bool) -> Vec<u64> {
     let mut search = Search::<false>::with_words(lattice, start, IVec3::ZERO, usize::MAX, wide);
     search.run(lattice, |_| false);
-    (0..lattice.len()).map(|cell| search.cost(cell)).collect()
+    (0..lattice.len())
+        .map(|cell| search.nodes().cost(cell))
+        .collect()
 }
 
 #[cfg(test)]

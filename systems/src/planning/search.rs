@@ -146,6 +146,7 @@ pub fn find_path(
         Search::<true>::new(lattice, start.cell, lattice.cell(goal.cell), max_expansions);
     search.run(lattice, |cell| cell == goal.cell);
     let cells = search
+        .nodes()
         .is_closed(goal.cell)
         .then(|| search.trace(lattice.moves(), goal.cell))?;
     Some(assemble(grid, &start, &cells, &goal))
@@ -229,7 +230,11 @@ impl<'g> PathSearch<'g> {
             self.ends[goal].get_or_insert_with(|| attach(grid, point, GOAL_SNAP_RADIUS_M));
         }
         for end in which.iter().filter_map(|&goal| self.ends[goal].flatten()) {
-            if self.search.as_ref().is_some_and(|s| s.is_closed(end.cell)) {
+            if self
+                .search
+                .as_ref()
+                .is_some_and(|s| s.nodes().is_closed(end.cell))
+            {
                 continue;
             }
             if self.pending.is_empty() {
@@ -259,6 +264,7 @@ impl<'g> PathSearch<'g> {
                 let end = self.ends[goal].flatten()?;
                 let search = self.search.as_ref()?;
                 let cells = search
+                    .nodes()
                     .is_closed(end.cell)
                     .then(|| search.trace(lattice.moves(), end.cell))?;
                 Some(assemble(self.grid, &start, &cells, &end))

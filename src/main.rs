@@ -176,20 +176,7 @@ fn main() -> ExitCode {
             out,
             overrides,
         } => calibrate_command(&airframe, out, &overrides.into_iter().collect()),
-        Command::Plot { dir } => match uavex_engine::plot::plot_dir(&dir) {
-            Ok(files) => {
-                println!(
-                    "{} plot files in {}",
-                    files.len(),
-                    dir.join("plots").display()
-                );
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                eprintln!("cannot plot {}: {e}", dir.display());
-                ExitCode::FAILURE
-            }
-        },
+        Command::Plot { dir } => write_plots(&dir),
         Command::Validate { scenarios } => {
             let mut all_valid = true;
             for path in &scenarios {
@@ -346,6 +333,11 @@ fn write_results(dir: &std::path::Path) -> ExitCode {
             return ExitCode::FAILURE;
         }
     }
+    write_plots(dir)
+}
+
+/// The plots of a results folder (`uavex plot`, and the end of a sweep or merge).
+fn write_plots(dir: &std::path::Path) -> ExitCode {
     match uavex_engine::plot::plot_dir(dir) {
         Ok(files) => {
             println!(

@@ -55,20 +55,9 @@ impl Stage {
 /// A schedule with the stages chained in tick order and no systems yet.
 pub fn tick_schedule() -> Schedule {
     let mut schedule = Schedule::new(Tick);
-    schedule.configure_sets(
-        (
-            Stage::Sense,
-            Stage::Map,
-            Stage::Frontier,
-            Stage::Decide,
-            Stage::Adapt,
-            Stage::Plan,
-            Stage::Control,
-            Stage::Physics,
-            Stage::Account,
-        )
-            .chain(),
-    );
+    for pair in Stage::ORDER.windows(2) {
+        schedule.configure_sets(pair[0].before(pair[1]));
+    }
     schedule
 }
 

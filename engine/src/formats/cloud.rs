@@ -11,7 +11,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::{Fault, FormatError, Problem, extension, pcd, ply, read_file};
+use super::{Fault, FormatError, Problem, load_by_extension, pcd, ply};
 
 /// The finite points of a cloud file and how many non-finite ones were skipped.
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -35,19 +35,11 @@ pub fn load_cloud(path: &Path) -> Result<Vec<Vec3>, FormatError> {
 
 /// [`load_cloud`], also telling how many non-finite points were skipped.
 pub fn load_cloud_counted(path: &Path) -> Result<PointCloud, FormatError> {
-    let parse: fn(&[u8]) -> Result<PointCloud, Fault> = match extension(path).as_str() {
-        "pcd" => pcd::parse_pcd,
-        "ply" => ply::parse_ply_points,
-        other => {
-            return Err(Fault::problem(Problem::UnsupportedExtension {
-                found: other.to_string(),
-                expected: CLOUD_EXTENSIONS,
-            })
-            .in_file(path));
-        }
-    };
-    let bytes = read_file(path)?;
-    parse(&bytes).map_err(|fault| fault.in_file(path))
+    load_by_extension(
+        path,
+        &[("pcd", pcd::parse_pcd), ("ply", ply::parse_ply_points)],
+        CLOUD_EXTENSIONS,
+    )
 }
 
 /// Collects points as a reader decodes them, skipping and counting non-finite ones.

@@ -4,7 +4,7 @@ use std::path::Path;
 
 use glam::Vec3;
 
-use super::{Fault, FormatError, Problem, extension, obj, read_file, stl};
+use super::{Fault, FormatError, Problem, load_by_extension, obj, stl};
 
 /// An indexed triangle mesh, in the file's own units and frame (metres, as scenarios assume).
 #[derive(Debug, Clone, Default, PartialEq)]
@@ -25,19 +25,11 @@ pub const MESH_EXTENSIONS: &str = ".obj, .stl";
 /// Errors name the file and, for text formats, the line; a mesh without any triangle, a
 /// non-finite vertex and an out-of-range index are errors.
 pub fn load_mesh(path: &Path) -> Result<TriangleMesh, FormatError> {
-    let parse: fn(&[u8]) -> Result<TriangleMesh, Fault> = match extension(path).as_str() {
-        "obj" => obj::parse_obj,
-        "stl" => stl::parse_stl,
-        other => {
-            return Err(Fault::problem(Problem::UnsupportedExtension {
-                found: other.to_string(),
-                expected: MESH_EXTENSIONS,
-            })
-            .in_file(path));
-        }
-    };
-    let bytes = read_file(path)?;
-    parse(&bytes).map_err(|fault| fault.in_file(path))
+    load_by_extension(
+        path,
+        &[("obj", obj::parse_obj), ("stl", stl::parse_stl)],
+        MESH_EXTENSIONS,
+    )
 }
 
 /// Checks what every reader promises: at least one triangle, indices in range, finite vertices.

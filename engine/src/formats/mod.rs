@@ -124,6 +124,26 @@ impl Fault {
     }
 }
 
+/// A parser of one file format, from the file's bytes.
+pub(crate) type Parser<T> = fn(&[u8]) -> Result<T, Fault>;
+
+/// Reads `path` with the parser that `parsers` names for its extension (lowercase, without
+/// the dot); an unknown extension is an error that lists the `expected` ones.
+pub(crate) fn load_by_extension<T>(
+    path: &Path,
+    parsers: &[(&str, Parser<T>)],
+    expected: &'static str,
+) -> Result<T, FormatError> {
+    let found = extension(path);
+    let Some((_, parse)) = parsers.iter().find(|(ext, _)| *ext == found) else {
+        return Err(
+            Fault::problem(Problem::UnsupportedExtension { found, expected }).in_file(path),
+        );
+    };
+    let bytes = read_file(path)?;
+    parse(&bytes).map_err(|fault| fault.in_file(path))
+}
+
 /// The lowercase extension of `path`, or "" when it has none.
 pub(crate) fn extension(path: &Path) -> String {
     path.extension()

@@ -5,7 +5,7 @@
 
 use super::flight_world::{FlightWorld, UavHandle, UavStatus};
 use uavex_components::trajectory::Trajectory;
-use uavex_systems::flight::{Completion, FlightState, GeometricController, Progress};
+use uavex_systems::flight::{Completion, FlightState, GeometricController, Progress, Tracking};
 
 /// What a flight of one trajectory measured.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -38,9 +38,7 @@ pub fn fly_trajectory(
     let dt = world.config().dt;
     let energy_before = world.meter(uav).energy_j;
     let mut steps: u64 = 0;
-    let mut squared_error_integral = 0.0;
-    let mut max_error: f64 = 0.0;
-    let mut peak_speed: f64 = 0.0;
+    let mut tracking = Tracking::default();
     let mut state = world.state(uav);
     let mut progress = completion.progress(0.0, trajectory, &state);
     let max_steps = ((trajectory.duration() + completion.settle_timeout) / dt).ceil() as u64 + 1;
@@ -55,14 +53,7 @@ pub fn fly_trajectory(
         steps += 1;
         let t = steps as f64 * dt;
         state = world.state(uav);
-        let error = state.position.distance(trajectory.sample(t).position);
-        squared_error_integral += error * error * dt;
-        max_error = max_error.max(error);
-        peak_speed = state
-            .rotor_speeds
-            .iter()
-            .cloned()
-            .fold(peak_speed, f64::max);
+        tracking.record(&state, trajectory.sample(t).position, dt);
         observe(t, &state, world.power_w(uav));
         progress = completion.progress(t, trajectory, &state);
     }
@@ -72,12 +63,8 @@ pub fn fly_trajectory(
         arrived: progress == Progress::Arrived,
         duration_s: duration,
         energy_j: world.meter(uav).energy_j - energy_before,
-        rms_tracking_error_m: if duration > 0.0 {
-            (squared_error_integral / duration).sqrt()
-        } else {
-            0.0
-        },
-        max_tracking_error_m: max_error,
-        peak_rotor_speed: peak_speed,
+        rms_tracking_error_m: tracking.rms_error(duration),
+        max_tracking_error_m: tracking.max_error_m,
+        peak_rotor_speed: tracking.peak_rotor_speed,
     }
 }

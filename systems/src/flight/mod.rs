@@ -26,8 +26,8 @@ pub use ecs::{
 };
 pub use energy::{Battery, EnergyMeter, EnergySummary};
 pub use rollout::{
-    Completion, Integrator, Progress, RolloutConfig, RolloutResult, rollout, rollout_batch,
-    rollout_observed,
+    Completion, Integrator, Progress, RolloutConfig, RolloutResult, Tracking, rollout,
+    rollout_batch, rollout_observed,
 };
 pub use state::FlightState;
 

@@ -23,6 +23,7 @@ use super::controller::{ControllerGains, GeometricController};
 use super::dynamics::{FlightDerivative, QuadrotorModel};
 use super::power::total_power;
 use super::state::FlightState;
+use glam::DVec3;
 use rayon::prelude::*;
 use uavex_components::airframe::Airframe;
 use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
@@ -181,9 +182,8 @@ pub fn rollout_observed(
     let mut state = *start;
     let mut t = 0.0;
     let mut energy = 0.0;
-    let mut squared_error_integral = 0.0;
-    let mut max_error: f64 = 0.0;
-    let mut peak_speed = start.rotor_speeds.iter().cloned().fold(0.0, f64::max);
+    let mut tracking = Tracking::default();
+    tracking.peak_rotor_speed = start.rotor_speeds.iter().cloned().fold(0.0, f64::max);
     let mut peak_power = total_power(&model.power, &start.rotor_speeds);
     let mut reference = trajectory.sample(0.0);
     let max_steps = ((duration + config.completion.settle_timeout) / h).ceil() as u64 + 1;
@@ -215,31 +215,54 @@ pub fn rollout_observed(
         }
         observe(t, &state);
         reference = end_reference;
-        let error = state.position.distance(reference.position);
-        squared_error_integral += error * error * h;
-        max_error = max_error.max(error);
-        peak_speed = state
-            .rotor_speeds
-            .iter()
-            .cloned()
-            .fold(peak_speed, f64::max);
+        tracking.record(&state, reference.position, h);
         peak_power = peak_power.max(total_power(&model.power, &state.rotor_speeds));
         progress = config.completion.progress(t, trajectory, &state);
     }
     Ok(RolloutResult {
         energy_j: energy,
         duration_s: t,
-        rms_tracking_error_m: if t > 0.0 {
-            (squared_error_integral / t).sqrt()
-        } else {
-            0.0
-        },
-        max_tracking_error_m: max_error,
-        peak_rotor_speed: peak_speed,
+        rms_tracking_error_m: tracking.rms_error(t),
+        max_tracking_error_m: tracking.max_error_m,
+        peak_rotor_speed: tracking.peak_rotor_speed,
         peak_power_w: peak_power,
         arrived: progress == Progress::Arrived,
         final_state: state,
     })
+}
+
+/// How closely a flight followed its reference, accumulated step by step (a rollout's, and a
+/// flight of the true quadrotor's in the engine).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Tracking {
+    /// Integral over time of the squared distance to the reference position (m^2 s).
+    pub squared_error_integral: f64,
+    pub max_error_m: f64,
+    /// Highest rotor speed seen (rad/s).
+    pub peak_rotor_speed: f64,
+}
+
+impl Tracking {
+    /// Adds a step of `dt` ending in `state`, whose reference position was `reference`.
+    pub fn record(&mut self, state: &FlightState, reference: DVec3, dt: f64) {
+        let error = state.position.distance(reference);
+        self.squared_error_integral += error * error * dt;
+        self.max_error_m = self.max_error_m.max(error);
+        self.peak_rotor_speed = state
+            .rotor_speeds
+            .iter()
+            .cloned()
+            .fold(self.peak_rotor_speed, f64::max);
+    }
+
+    /// Root mean square of the error over a flight of `duration` (s); 0 for none.
+    pub fn rms_error(&self, duration: f64) -> f64 {
+        if duration > 0.0 {
+            (self.squared_error_integral / duration).sqrt()
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Rolls out many (start, trajectory) pairs in parallel (rayon); results in input order.

@@ -18,21 +18,7 @@ impl FlightWorld {
             body.add_force(force.as_vec3(), true);
             body.add_torque(torque.as_vec3(), true);
         }
-        self.pipeline.step(
-            Vector::new(0.0, 0.0, -self.gravity as f32),
-            &self.params,
-            &mut self.islands,
-            &mut self.broad_phase,
-            &mut self.narrow_phase,
-            &mut self.bodies,
-            &mut self.colliders,
-            &mut self.impulse_joints,
-            &mut self.multibody_joints,
-            &mut self.soft_bodies,
-            &mut self.ccd_solver,
-            &(),
-            &(),
-        );
+        self.run_pipeline(self.params);
         self.counts.pipeline_steps += 1;
     }
 
@@ -88,10 +74,14 @@ impl FlightWorld {
     /// A zero-length pipeline step: inserts the colliders into the broad phase and updates
     /// the narrow phase without moving anything.
     pub(super) fn update_collision_detection(&mut self) {
-        let params = IntegrationParameters {
+        self.run_pipeline(IntegrationParameters {
             dt: 0.0,
             ..self.params
-        };
+        });
+    }
+
+    /// One step of rapier's pipeline over the whole world with `params`, under gravity.
+    fn run_pipeline(&mut self, params: IntegrationParameters) {
         self.pipeline.step(
             Vector::new(0.0, 0.0, -self.gravity as f32),
             &params,

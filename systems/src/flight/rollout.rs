@@ -182,8 +182,10 @@ pub fn rollout_observed(
     let mut state = *start;
     let mut t = 0.0;
     let mut energy = 0.0;
-    let mut tracking = Tracking::default();
-    tracking.peak_rotor_speed = start.rotor_speeds.iter().cloned().fold(0.0, f64::max);
+    let mut tracking = Tracking {
+        peak_rotor_speed: start.rotor_speeds.iter().cloned().fold(0.0, f64::max),
+        ..Tracking::default()
+    };
     let mut peak_power = total_power(&model.power, &start.rotor_speeds);
     let mut reference = trajectory.sample(0.0);
     let max_steps = ((duration + config.completion.settle_timeout) / h).ceil() as u64 + 1;

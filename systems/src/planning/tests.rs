@@ -483,6 +483,58 @@ fn a_parents_moves_prune_the_moves_they_already_relaxed() {
     }
 }
 
+/// A known room of 4.8 x 4.8 x 2.4 m, free but for ten boxes of random places and sizes.
+fn boxes_in_a_room(rng: &mut ChaCha8Rng) -> TestMap {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(4.8, 4.8, 2.4));
+    map.fill_all(FREE);
+    for _ in 0..10 {
+        let lo = IVec3::new(
+            rng.random_range(0..44),
+            rng.random_range(0..44),
+            rng.random_range(0..20),
+        );
+        let size = IVec3::new(
+            rng.random_range(1..10),
+            rng.random_range(1..10),
+            rng.random_range(1..16),
+        );
+        map.fill(lo, lo + size, OCCUPIED);
+    }
+    map
+}
+
+/// Skipping the moves that cannot lower a cost changes nothing a search does: the pruned
+/// Dijkstra closes the same cells in the same order, with the same costs and arrivals, as
+/// the one that relaxes every move. The rooms have both cells with all 26 neighbours open
+/// (`best_first::DOMINATED_IN_OPEN`) and cells near the boxes and walls (the parent's rule).
+#[test]
+fn pruning_changes_no_cost_arrival_or_order() {
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    for _ in 0..3 {
+        let grid = boxes_in_a_room(&mut rng).grid(0.15);
+        let lattice = grid.lattice();
+        let open: Vec<usize> = (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect();
+        let surrounded = open
+            .iter()
+            .filter(|&&c| lattice.allowed_moves(c).count_ones() == 26)
+            .count();
+        assert!(
+            surrounded > 1000 && open.len() - surrounded > 1000,
+            "{surrounded} of {} open cells surrounded",
+            open.len()
+        );
+        for _ in 0..2 {
+            let start = open[rng.random_range(0..open.len())];
+            let pruned = best_first::closing_order(lattice, start, true);
+            assert!(pruned.len() > 1000, "{} cells closed", pruned.len());
+            assert!(
+                pruned == best_first::closing_order(lattice, start, false),
+                "from cell {start}"
+            );
+        }
+    }
+}
+
 /// The pruned Dijkstra's costs are the shortest lattice distances: every reached cell's cost
 /// is no more than any neighbour's plus the move (so no improving relaxation was skipped), and
 /// equals one of them (or is the start's 0). The searches on `u32` and `u64` words find the
@@ -492,22 +544,7 @@ fn a_parents_moves_prune_the_moves_they_already_relaxed() {
 fn pruned_searches_keep_every_cost_shortest() {
     let mut rng = ChaCha8Rng::seed_from_u64(12);
     for _ in 0..3 {
-        let mut map = TestMap::new(DVec3::ZERO, DVec3::new(4.8, 4.8, 2.4));
-        map.fill_all(FREE);
-        for _ in 0..10 {
-            let lo = IVec3::new(
-                rng.random_range(0..44),
-                rng.random_range(0..44),
-                rng.random_range(0..20),
-            );
-            let size = IVec3::new(
-                rng.random_range(1..10),
-                rng.random_range(1..10),
-                rng.random_range(1..16),
-            );
-            map.fill(lo, lo + size, OCCUPIED);
-        }
-        let grid = map.grid(0.15);
+        let grid = boxes_in_a_room(&mut rng).grid(0.15);
         let lattice = grid.lattice();
         let open: Vec<usize> = (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect();
         let starts: Vec<usize> = (0..4)

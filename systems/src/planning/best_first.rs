@@ -295,19 +295,31 @@ const ALL_MOVES: u32 = (1 << 26) - 1;
 /// lower any cost, whatever the parent allows: those [`relaxed_by_parent`] skips (the parent's
 /// own move `d + e` is allowed, as its box lies among the open neighbours), the way back (`-d`),
 /// and every `e` whose target a path of two moves from the parent around the cell reaches for
-/// strictly less than `w(d) + w(e)`.
+/// strictly less than `w(d) + w(e)` ([`DOMINATED_BY_TWO_MOVES`] says why those cannot).
 ///
-/// Why those cannot: the two moves go from the parent through an open neighbour `y` of the
-/// cell to its target, within the open neighbourhood (so both are allowed), and the target's
-/// final cost is at most `g(parent) + w(a) + w(b)`, below the cell's offer. The offer is never
-/// final: without it the target may be reached meanwhile at another cost that is not final
-/// either, and pushed once more, but a queue entry above a cell's final cost pops after the
-/// cell has closed and is skipped, and the first offer at the final cost comes from the same
-/// expansion as before. The search closes the same cells in the same order, with the same costs
-/// and arrivals, bit for bit. It relaxes 5 instead of 15 moves from a cell entered along a
-/// face diagonal, 7 instead of 19 from one entered along a space diagonal; ties are left
-/// alone (they would change which of two equal paths is kept), so an axis arrival keeps 9.
-const DOMINATED_IN_OPEN: [u32; 26] = {
+/// A cell entered along a face diagonal relaxes 5 of its moves instead of 15, one entered
+/// along a space diagonal 7 instead of 19; ties are left alone (they would change which of two
+/// equal paths is kept), so an axis arrival keeps 9.
+const DOMINATED_IN_OPEN: [u32; 26] = dominated_moves(true);
+
+/// For each arrival `d`, the moves `e` that cannot lower any cost next to obstacles too: the
+/// way back, and every `e` whose target a path of two moves from the parent reaches for
+/// strictly less than `w(d) + w(e)` through cells of the boxes of `d` and `e` alone, which are
+/// open (the search took `d`, and relaxes `e` only if allowed), so both moves are allowed.
+///
+/// Why those cannot: the target's final cost is at most `g(parent) + w(a) + w(b)`, below the
+/// cell's offer. The offer is never final: without it the target may be reached meanwhile at
+/// another cost that is not final either, and pushed once more, but a queue entry above a
+/// cell's final cost pops after the cell has closed and is skipped, and the first offer at the
+/// final cost comes from the same expansion as before. The search closes the same cells in the
+/// same order, with the same costs and arrivals, bit for bit. 6 of the 15 moves a face-diagonal
+/// arrival leaves to [`relaxed_by_parent`] are among them, all 12 of the 19 of a space-diagonal
+/// one.
+const DOMINATED_BY_TWO_MOVES: [u32; 26] = dominated_moves(false);
+
+/// The tables above: with `open` the cell's 26 neighbours are all open, else only the boxes of
+/// its arrival and of the move out are known to be.
+const fn dominated_moves(open: bool) -> [u32; 26] {
     let mut dominated = [0; 26];
     let mut k = 0;
     while k < 26 {
@@ -319,17 +331,16 @@ const DOMINATED_IN_OPEN: [u32; 26] = {
             let offer = move_cost(d) + move_cost(e);
             let direct = [e[0] - parent[0], e[1] - parent[1], e[2] - parent[2]];
             let mut skip = (e[0] == parent[0] && e[1] == parent[1] && e[2] == parent[2])
-                || (is_move(direct) && move_cost(direct) <= offer);
+                || (open && is_move(direct) && move_cost(direct) <= offer);
             let mut y = 0;
             while y < 27 {
-                let y_at = cube_offset(y as u32);
-                let a = [
-                    y_at[0] - parent[0],
-                    y_at[1] - parent[1],
-                    y_at[2] - parent[2],
-                ];
-                let b = [e[0] - y_at[0], e[1] - y_at[1], e[2] - y_at[2]];
-                if y != 13 && is_move(a) && is_move(b) && move_cost(a) + move_cost(b) < offer {
+                let via = cube_offset(y);
+                let a = [via[0] - parent[0], via[1] - parent[1], via[2] - parent[2]];
+                let b = [e[0] - via[0], e[1] - via[1], e[2] - via[2]];
+                let shorter = is_move(a) && is_move(b) && move_cost(a) + move_cost(b) < offer;
+                let known_open = open
+                    || (box_is_known(parent, via, parent, e) && box_is_known(via, e, parent, e));
+                if y != 13 && shorter && known_open {
                     skip = true;
                 }
                 y += 1;
@@ -342,7 +353,40 @@ const DOMINATED_IN_OPEN: [u32; 26] = {
         k += 1;
     }
     dominated
-};
+}
+
+/// Whether every cell of the box spanned by `u` and `v` (offsets in the cube around a cell
+/// reached from `parent`) lies in the box from the parent to the cell or in the box from the
+/// cell to `e`.
+const fn box_is_known(u: [i32; 3], v: [i32; 3], parent: [i32; 3], e: [i32; 3]) -> bool {
+    let centre = [0; 3];
+    let mut c = 0;
+    while c < 27 {
+        let cell = cube_offset(c);
+        if in_box(cell, u, v) && !in_box(cell, parent, centre) && !in_box(cell, centre, e) {
+            return false;
+        }
+        c += 1;
+    }
+    true
+}
+
+/// Whether `cell` lies in the box spanned by `u` and `v`.
+const fn in_box(cell: [i32; 3], u: [i32; 3], v: [i32; 3]) -> bool {
+    let mut axis = 0;
+    while axis < 3 {
+        let (low, high) = if u[axis] < v[axis] {
+            (u[axis], v[axis])
+        } else {
+            (v[axis], u[axis])
+        };
+        if cell[axis] < low || cell[axis] > high {
+            return false;
+        }
+        axis += 1;
+    }
+    true
+}
 
 /// The offset of cube bit `c` (in {-1, 0, 1}^3).
 const fn cube_offset(c: u32) -> [i32; 3] {
@@ -594,7 +638,8 @@ fn expand<const ASTAR: bool, W: Word>(
             DOMINATED_IN_OPEN[arrival]
         } else {
             let parent = index.wrapping_add_signed(-moves[arrival].offset);
-            relaxed_by_parent(arrival, lattice.allowed_moves(parent))
+            DOMINATED_BY_TWO_MOVES[arrival]
+                | relaxed_by_parent(arrival, lattice.allowed_moves(parent))
         };
     }
     while allowed != 0 {
@@ -650,6 +695,30 @@ pub(super) fn closing_order(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// How many moves each table leaves to relax, by the kind of arrival (the figures of their
+    /// documentation): every arrival of a kind is the same up to symmetry.
+    #[test]
+    fn the_tables_leave_the_moves_their_documentation_counts() {
+        for k in 0..26 {
+            let axes = cube_offset(cube_bit(k)).iter().filter(|&&c| c != 0).count();
+            let in_open = 26 - DOMINATED_IN_OPEN[k].count_ones();
+            // Moves left to the parent's rule; then how many of those two moves always beat.
+            let by_parent = relaxed_by_parent(k, ALL_MOVES) | 1 << (25 - k);
+            let left = 26 - by_parent.count_ones();
+            let beaten = (DOMINATED_BY_TWO_MOVES[k] & !by_parent).count_ones();
+            assert_eq!(
+                (in_open, left, beaten),
+                [(9, 9, 0), (5, 15, 6), (7, 19, 12)][axes - 1],
+                "arrival {:?}",
+                cube_offset(cube_bit(k))
+            );
+            // The way back is always skipped, and what is skipped next to obstacles is also
+            // skipped in the open.
+            assert_ne!(DOMINATED_BY_TWO_MOVES[k] & 1 << (25 - k), 0);
+            assert_eq!(DOMINATED_BY_TWO_MOVES[k] & !DOMINATED_IN_OPEN[k], 0);
+        }
+    }
 
     #[test]
     fn narrow_words_hold_any_cost_of_the_lattices_they_are_used_for() {

@@ -235,7 +235,8 @@ impl<W: Word> Cells for Nodes<W> {
 /// benches/planning.rs: 23.6 allowed moves per expanded cell, 17.0 relaxed). A cell entered
 /// along an axis has 17 of its 26 moves covered by its parent, one entered along a space
 /// diagonal only 7. A cell whose 26 neighbours are all open skips more
-/// ([`DOMINATED_IN_OPEN`]); this rule serves the cells near obstacles.
+/// ([`DOMINATED_IN_OPEN`]); this rule serves the cells near obstacles, with
+/// [`DOMINATED_BY_TWO_MOVES`].
 #[inline(always)]
 pub(super) fn relaxed_by_parent(arrival: usize, parent_allowed: u32) -> u32 {
     // In the 3 x 3 x 3 cube layout (bit (x+1) + 3 (y+1) + 9 (z+1), the centre 13 unused),
@@ -450,7 +451,8 @@ struct RunState {
     /// The queue ran empty, or the expansions ran out: no cell will settle any more.
     done: bool,
     /// Whether expansions skip the moves that cannot lower a cost ([`relaxed_by_parent`],
-    /// [`DOMINATED_IN_OPEN`]); off only in the tests that check the skipping changes nothing.
+    /// [`DOMINATED_IN_OPEN`], [`DOMINATED_BY_TWO_MOVES`]); off only in the test that checks
+    /// the skipping changes nothing.
     prune: bool,
 }
 

@@ -34,23 +34,70 @@ pub const GOAL_SNAP_RADIUS_M: f64 = 1.0;
 pub const MIN_POINT_SEPARATION_M: f64 = 0.01;
 
 /// Where a query point joins the lattice.
-#[derive(Debug, Clone, Copy)]
-struct Endpoint {
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) struct Endpoint {
     point: DVec3,
     cell: usize,
     /// Whether `point` itself is traversable (it is then part of the path).
-    traversable: bool,
+    pub(super) traversable: bool,
 }
 
-fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint> {
-    let lattice = grid.lattice();
-    if !point.is_finite() || !lattice.is_available() {
-        return None;
+pub(super) fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint> {
+    let around = Around::of(grid, point, radius)?;
+    match nearest_open(grid, point, &around, radius) {
+        // No open cell within reach: the scan would find none either.
+        Nearest::NoneWithin => None,
+        Nearest::Cell(cell, centre) if !around.traversable || grid.line_of_sight(point, centre) => {
+            Some(Endpoint {
+                point,
+                cell,
+                traversable: around.traversable,
+            })
+        }
+        // The nearest is not seen (or the cube is beyond the table): every candidate in order.
+        Nearest::Cell(..) | Nearest::TooFar => attach_by_scan(grid, point, radius, &around),
     }
-    let resolution = grid.resolution();
-    let traversable = grid.is_traversable_point(point);
-    let home = Lattice::cell_of_key(grid.key_of(point));
-    let n = (radius / (2.0 * resolution)).ceil() as i32 + 1;
+}
+
+/// Where a query point lies on the lattice.
+#[derive(Clone, Copy)]
+pub(super) struct Around {
+    /// Whether the point itself is traversable.
+    traversable: bool,
+    /// The cell holding the point.
+    home: IVec3,
+    /// Half edge (cells) of the cube around `home` that holds every cell within the radius.
+    n: i32,
+}
+
+impl Around {
+    /// `None` for a point that is not finite or a grid without a lattice.
+    pub(super) fn of(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Self> {
+        if !point.is_finite() || !grid.lattice().is_available() {
+            return None;
+        }
+        Some(Self {
+            traversable: grid.is_traversable_point(point),
+            home: Lattice::cell_of_key(grid.key_of(point)),
+            n: (radius / (2.0 * grid.resolution())).ceil() as i32 + 1,
+        })
+    }
+}
+
+/// [`attach`] by a scan of every cell of the cube around the point's, the candidates within
+/// `radius` then taken nearest first until one is seen (a traversable point) or at once.
+pub(super) fn attach_by_scan(
+    grid: &TraversableGrid,
+    point: DVec3,
+    radius: f64,
+    around: &Around,
+) -> Option<Endpoint> {
+    let (lattice, resolution) = (grid.lattice(), grid.resolution());
+    let Around {
+        traversable,
+        home,
+        n,
+    } = *around;
     // Planes and rows of cells whose centres all lie farther than `radius` (with a margin for
     // rounding) hold no candidate and are skipped whole.
     let beyond = radius * radius * (1.0 + 1e-9);
@@ -98,6 +145,72 @@ fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint>
         }
     }
     None
+}
+
+/// What [`nearest_open`] found.
+enum Nearest {
+    /// The open cell nearest to the point within the radius (by distance, then index), and
+    /// its centre.
+    Cell(usize, DVec3),
+    NoneWithin,
+    /// The cube to search is larger than [`NEAREST_FIRST_REACH`].
+    TooFar,
+}
+
+/// Half edge (cells) of the cube of offsets [`nearest_first`] orders.
+const NEAREST_FIRST_REACH: i32 = 12;
+
+/// The cell offsets of the cube of half edge [`NEAREST_FIRST_REACH`], nearest first (by
+/// squared length), each with its length.
+fn nearest_first() -> &'static [(f64, IVec3)] {
+    static OFFSETS: std::sync::OnceLock<Vec<(f64, IVec3)>> = std::sync::OnceLock::new();
+    OFFSETS.get_or_init(|| {
+        let r = NEAREST_FIRST_REACH;
+        let mut offsets: Vec<IVec3> = (-r..=r)
+            .flat_map(|z| (-r..=r).flat_map(move |y| (-r..=r).map(move |x| IVec3::new(x, y, z))))
+            .collect();
+        offsets.sort_by_key(|d| d.length_squared());
+        offsets
+            .into_iter()
+            .map(|d| (d.as_dvec3().length(), d))
+            .collect()
+    })
+}
+
+/// The open cell nearest to `point` within `radius`, by distance then cell index, as
+/// [`attach_by_scan`] orders its candidates, found by looking at the
+/// cells around `home` nearest first and stopping once no farther one can be nearer: the
+/// nearest open cell is mostly a few cells away, and the scan looked at the whole cube of
+/// `n` cells around `home` (some 1,000 cells for a goal). A cell at offset `d` lies at least
+/// `|d| 2 resolution - |point - centre(home)|` from the point (triangle inequality; a
+/// nanometre of margin for rounding).
+fn nearest_open(grid: &TraversableGrid, point: DVec3, around: &Around, radius: f64) -> Nearest {
+    let Around { home, n, .. } = *around;
+    if n > NEAREST_FIRST_REACH {
+        return Nearest::TooFar;
+    }
+    let (lattice, resolution) = (grid.lattice(), grid.resolution());
+    let slack = lattice.centre(home, resolution).distance(point) + 1e-9;
+    let mut best: Option<(f64, usize, DVec3)> = None;
+    for &(length, d) in nearest_first() {
+        let reach = best.map_or(radius, |b| b.0);
+        if length * 2.0 * resolution - slack > reach {
+            break;
+        }
+        let cell = home + d;
+        let Some(index) = lattice.index(cell).filter(|&i| lattice.is_open(i)) else {
+            continue;
+        };
+        let centre = lattice.centre(cell, resolution);
+        let distance = centre.distance(point);
+        let nearer = best.is_none_or(|(bd, bi, _)| distance < bd || (distance == bd && index < bi));
+        if distance <= radius && nearer {
+            best = Some((distance, index, centre));
+        }
+    }
+    best.map_or(Nearest::NoneWithin, |(_, cell, centre)| {
+        Nearest::Cell(cell, centre)
+    })
 }
 
 /// Appends `p`, merging it with the last point when closer than [`MIN_POINT_SEPARATION_M`]

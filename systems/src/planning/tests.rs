@@ -578,6 +578,57 @@ fn pruned_searches_keep_every_cost_shortest() {
     }
 }
 
+/// Attaching a point by looking at the cells nearest first finds what the scan of the whole
+/// cube finds: the same cell, or none, for points open, blocked, in unknown space and outside
+/// the map, with the radii of starts and goals.
+#[test]
+fn nearest_first_attachment_agrees_with_the_full_scan() {
+    use super::search::{Around, attach, attach_by_scan};
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut open, mut blocked, mut none) = (0, 0, 0);
+    for _ in 0..3 {
+        let mut map = boxes_in_a_room(&mut rng);
+        // A slab of unknown space, as frontier goals face.
+        map.fill(
+            IVec3::new(0, 0, 10),
+            IVec3::new(47, 20, 14),
+            uavex_components::map::UNKNOWN_LOG_ODDS,
+        );
+        let grid = map.grid(0.15);
+        for i in 0..600 {
+            // Random points, and corners shared by cells, as near to several centres as to
+            // any (ties broken by index).
+            let point = if i % 3 == 0 {
+                DVec3::new(
+                    0.2 * rng.random_range(0..24) as f64,
+                    0.2 * rng.random_range(0..24) as f64,
+                    0.2 * rng.random_range(0..12) as f64,
+                )
+            } else {
+                DVec3::new(
+                    rng.random_range(-0.6..5.4),
+                    rng.random_range(-0.6..5.4),
+                    rng.random_range(-0.4..2.8),
+                )
+            };
+            for radius in [SNAP_RADIUS_M, super::search::GOAL_SNAP_RADIUS_M] {
+                let around = Around::of(&grid, point, radius).unwrap();
+                let expected = attach_by_scan(&grid, point, radius, &around);
+                assert_eq!(attach(&grid, point, radius), expected, "{point} {radius}");
+                match expected {
+                    Some(end) if end.traversable => open += 1,
+                    Some(_) => blocked += 1,
+                    None => none += 1,
+                }
+            }
+        }
+    }
+    assert!(
+        open > 100 && blocked > 100 && none > 100,
+        "{open} {blocked} {none}"
+    );
+}
+
 #[test]
 fn a_blocked_start_is_attached_to_the_nearest_open_cell() {
     let mut map = wall_room();

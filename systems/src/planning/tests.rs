@@ -506,7 +506,8 @@ fn boxes_in_a_room(rng: &mut ChaCha8Rng) -> TestMap {
 /// Skipping the moves that cannot lower a cost changes nothing a search does: the pruned
 /// Dijkstra closes the same cells in the same order, with the same costs and arrivals, as
 /// the one that relaxes every move. The rooms have both cells with all 26 neighbours open
-/// (`best_first::DOMINATED_IN_OPEN`) and cells near the boxes and walls (the parent's rule).
+/// (`best_first::DOMINATED_IN_OPEN`) and cells near the boxes and walls (the parent's rule and
+/// `best_first::DOMINATED_BY_TWO_MOVES`).
 #[test]
 fn pruning_changes_no_cost_arrival_or_order() {
     let mut rng = ChaCha8Rng::seed_from_u64(31);

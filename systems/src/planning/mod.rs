@@ -22,6 +22,7 @@ pub mod check;
 pub mod global;
 pub mod lattice;
 pub mod local;
+mod pruning;
 pub mod search;
 pub mod sight;
 pub mod traversable;
@@ -30,6 +31,8 @@ pub mod traversable;
 mod tests;
 #[cfg(test)]
 mod tests_planner;
+#[cfg(test)]
+mod tests_search;
 
 pub use check::{first_untraversable, refresh_along, remains_traversable};
 pub use global::{GlobalPlan, plan_along, plan_along_seen, plan_global};

@@ -1,0 +1,365 @@
+//! Tests of the path searches: A* and the multi-goal Dijkstra against each other and against
+//! shortest lattice distances, the moves they skip, and how query points join the lattice.
+
+use super::tests::{FREE, OCCUPIED, TestMap, wall_room};
+use super::*;
+use glam::{DVec3, IVec3};
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+#[test]
+fn a_star_goes_around_the_wall_by_the_shortest_lattice_path() {
+    let mut map = wall_room();
+    let grid = map.grid(0.0);
+    // Cells (5, 5, 3) to (25, 5, 3); the wall fills cell column x = 15 for y cells 0..=19.
+    // Without corner cutting the path passes (14, 20), (15, 20), (16, 20): 9 diagonals and
+    // 6 straight moves on each side, plus 2 straight moves across: 18 sqrt 2 + 14 cells.
+    let (from, to) = (DVec3::new(1.1, 1.1, 0.7), DVec3::new(5.1, 1.1, 0.7));
+    let path = find_path(&grid, from, to, usize::MAX).unwrap();
+    let expected = (18.0 * 2f64.sqrt() + 14.0) * 0.2;
+    assert!(
+        (path_length(&path) - expected).abs() < 1e-9,
+        "{}",
+        path_length(&path)
+    );
+    assert_eq!((path[0], *path.last().unwrap()), (from, to));
+    // Every leg crosses traversable voxels only.
+    assert!(path.windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    // The shortened path: chords of sight only, no longer than the lattice path, no shorter
+    // than the way around the wall's end (1.1, 1.1) -> (3.0, 4.0) -> (3.2, 4.0) -> (5.1, 1.1).
+    let short = shortcut(&grid, &path);
+    assert!(short.windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    let around = 2.0 * (1.9f64.powi(2) + 2.9f64.powi(2)).sqrt() + 0.2;
+    let length = path_length(&short);
+    assert!(around <= length && length < expected, "{length}");
+    assert!(short.len() < path.len());
+    // In the open, the shortened path is the straight chord.
+    let open = find_path(
+        &grid,
+        DVec3::new(4.1, 5.1, 0.7),
+        DVec3::new(6.1, 0.5, 1.3),
+        10_000,
+    );
+    assert_eq!(shortcut(&grid, &open.unwrap()).len(), 2);
+}
+
+#[test]
+fn enclosed_goals_and_limits_give_none() {
+    let mut map = wall_room();
+    // A hollow box around (1.1 .. 1.4 m): occupied shell, free inside.
+    map.fill(IVec3::new(5, 5, 2), IVec3::new(20, 20, 13), OCCUPIED);
+    map.fill(IVec3::new(6, 6, 3), IVec3::new(19, 19, 12), FREE);
+    let grid = map.grid(0.0);
+    let inside = DVec3::new(1.3, 1.3, 0.7);
+    let outside = DVec3::new(5.1, 1.1, 0.7);
+    assert!(grid.is_traversable_point(inside));
+    assert_eq!(find_path(&grid, outside, inside, usize::MAX), None);
+    assert_eq!(find_path(&grid, inside, outside, usize::MAX), None);
+    // Reachable, but not within 10 expansions.
+    let far = DVec3::new(5.1, 5.1, 0.7);
+    assert!(find_path(&grid, outside, far, usize::MAX).is_some());
+    assert_eq!(find_path(&grid, outside, far, 10), None);
+    let both = find_paths(&grid, outside, &[inside, far, DVec3::NAN], usize::MAX);
+    assert_eq!(
+        (both[0].is_none(), both[1].is_some(), both[2].is_none()),
+        (true, true, true)
+    );
+}
+
+/// A 6.4 x 6.4 x 2.4 m room of free space with a dozen random pillars (inflated by 0.27 m), a
+/// traversable start and a dozen random goals.
+fn random_room(rng: &mut ChaCha8Rng) -> (TraversableGrid, DVec3, Vec<DVec3>) {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 2.4));
+    map.fill_all(FREE);
+    for _ in 0..12 {
+        let lo = IVec3::new(rng.random_range(0..60), rng.random_range(0..60), 0);
+        let size = IVec3::new(rng.random_range(2..14), rng.random_range(2..14), 23);
+        map.fill(lo, lo + size, OCCUPIED);
+    }
+    let grid = map.grid(0.27);
+    let random_point = |rng: &mut ChaCha8Rng| {
+        DVec3::new(
+            rng.random_range(0.0..6.4),
+            rng.random_range(0.0..6.4),
+            rng.random_range(0.0..2.4),
+        )
+    };
+    let from = (0..1000)
+        .map(|_| random_point(rng))
+        .find(|&p| grid.is_traversable_point(p))
+        .unwrap();
+    let goals = (0..12).map(|_| random_point(rng)).collect();
+    (grid, from, goals)
+}
+
+#[test]
+fn find_paths_agrees_with_find_path_on_random_maps() {
+    let mut rng = ChaCha8Rng::seed_from_u64(11);
+    for _ in 0..3 {
+        let (grid, from, goals) = random_room(&mut rng);
+        let many = find_paths(&grid, from, &goals, usize::MAX);
+        let mut found = 0;
+        for (goal, path) in goals.iter().zip(&many) {
+            let single = find_path(&grid, from, *goal, usize::MAX);
+            assert_eq!(single.is_some(), path.is_some(), "{goal}");
+            if let (Some(a), Some(b)) = (single, path) {
+                assert!((path_length(&a) - path_length(b)).abs() < 1e-6);
+                assert_eq!((a[0], a.last()), (b[0], b.last()));
+                found += 1;
+            }
+        }
+        assert!(found > 0);
+    }
+}
+
+/// A goal on the way to another: the search stops at the first, and must expand it when it
+/// goes on (in a corridor one cell wide, nothing else leads on).
+#[test]
+fn a_search_goes_on_through_the_goal_it_stopped_at() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 2.4, 0.8));
+    map.fill_all(OCCUPIED);
+    // Voxels y 10..=11, z 2..=3: one lattice cell across.
+    map.fill(IVec3::new(0, 10, 2), IVec3::new(63, 11, 3), FREE);
+    let grid = map.grid(0.0);
+    let at = |x: f64| DVec3::new(x, 1.1, 0.3);
+    let goals = [at(3.1), at(5.9)];
+    let all = find_paths(&grid, at(0.3), &goals, usize::MAX);
+    assert!(all.iter().all(Option::is_some));
+    let mut search = PathSearch::new(&grid, at(0.3), &goals, usize::MAX);
+    assert_eq!(search.paths(&[0])[0], all[0]);
+    assert_eq!(search.paths(&[1])[0], all[1]);
+}
+
+/// Goals asked for a few at a time, in any order and again, get exactly the paths of one
+/// search for all of them (with and without a limit on expansions, which counts over the
+/// whole search), and the search stops as soon as the goals asked for so far are settled.
+#[test]
+fn a_search_asked_goal_by_goal_gives_the_paths_of_one_search() {
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for _ in 0..4 {
+        let (grid, from, goals) = random_room(&mut rng);
+        let full = PathSearch::new(&grid, from, &goals, usize::MAX);
+        let expanded_for_all = {
+            let mut full = full;
+            full.paths(&(0..goals.len()).collect::<Vec<_>>());
+            full.expanded_cells()
+        };
+        for limit in [usize::MAX, expanded_for_all / 2] {
+            let all = find_paths(&grid, from, &goals, limit);
+            let mut search = PathSearch::new(&grid, from, &goals, limit);
+            let mut asked: Vec<usize> = (0..goals.len()).chain([0, 5]).collect();
+            asked.sort_by_key(|_| rng.random_range(0..100));
+            for batch in asked.chunks(rng.random_range(1..4)) {
+                for (&goal, path) in batch.iter().zip(search.paths(batch)) {
+                    assert_eq!(path, all[goal], "goal {goal} with limit {limit}");
+                }
+            }
+        }
+        // The nearest goal with a path, alone: a fraction of the cells.
+        let nearest = (0..goals.len())
+            .filter(|&g| find_path(&grid, from, goals[g], usize::MAX).is_some())
+            .min_by(|&a, &b| goals[a].distance(from).total_cmp(&goals[b].distance(from)))
+            .unwrap();
+        let mut search = PathSearch::new(&grid, from, &goals, usize::MAX);
+        assert!(search.paths(&[nearest])[0].is_some());
+        assert!(
+            search.expanded_cells() < expanded_for_all,
+            "{} of {expanded_for_all} cells for the nearest goal",
+            search.expanded_cells()
+        );
+    }
+}
+
+/// The pruning of the searches (`pruning::relaxed_by_parent`), bit by bit: it is linear in the
+/// parent's moves, so one parent move at a time covers every case. From a cell reached by move
+/// `d`, move `e` is skipped exactly when the parent allows `d + e`.
+#[test]
+fn a_parents_moves_prune_the_moves_they_already_relaxed() {
+    let grid = TestMap::new(DVec3::ZERO, DVec3::ONE).grid(0.1);
+    let moves = grid.lattice().moves();
+    for (k, d) in moves.iter().enumerate() {
+        for (j, f) in moves.iter().enumerate() {
+            let expected = moves
+                .iter()
+                .enumerate()
+                .filter(|(_, e)| e.delta + d.delta == f.delta)
+                .fold(0u32, |bits, (i, _)| bits | 1 << i);
+            assert_eq!(
+                pruning::relaxed_by_parent(k, 1 << j),
+                expected,
+                "arrival {}, parent move {}",
+                d.delta,
+                f.delta
+            );
+        }
+    }
+}
+
+/// A known room of 4.8 x 4.8 x 2.4 m, free but for ten boxes of random places and sizes.
+fn boxes_in_a_room(rng: &mut ChaCha8Rng) -> TestMap {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(4.8, 4.8, 2.4));
+    map.fill_all(FREE);
+    for _ in 0..10 {
+        let lo = IVec3::new(
+            rng.random_range(0..44),
+            rng.random_range(0..44),
+            rng.random_range(0..20),
+        );
+        let size = IVec3::new(
+            rng.random_range(1..10),
+            rng.random_range(1..10),
+            rng.random_range(1..16),
+        );
+        map.fill(lo, lo + size, OCCUPIED);
+    }
+    map
+}
+
+/// Skipping the moves that cannot lower a cost changes nothing a search does: the pruned
+/// Dijkstra closes the same cells in the same order, with the same costs and arrivals, as
+/// the one that relaxes every move. The rooms have both cells with all 26 neighbours open
+/// (`pruning::DOMINATED_IN_OPEN`) and cells near the boxes and walls (the parent's rule and
+/// `pruning::DOMINATED_BY_TWO_MOVES`).
+#[test]
+fn pruning_changes_no_cost_arrival_or_order() {
+    let mut rng = ChaCha8Rng::seed_from_u64(31);
+    for _ in 0..3 {
+        let grid = boxes_in_a_room(&mut rng).grid(0.15);
+        let lattice = grid.lattice();
+        let open: Vec<usize> = (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect();
+        let surrounded = open
+            .iter()
+            .filter(|&&c| lattice.allowed_moves(c).count_ones() == 26)
+            .count();
+        assert!(
+            surrounded > 1000 && open.len() - surrounded > 1000,
+            "{surrounded} of {} open cells surrounded",
+            open.len()
+        );
+        for _ in 0..2 {
+            let start = open[rng.random_range(0..open.len())];
+            let pruned = best_first::closing_order(lattice, start, true);
+            assert!(pruned.len() > 1000, "{} cells closed", pruned.len());
+            assert!(
+                pruned == best_first::closing_order(lattice, start, false),
+                "from cell {start}"
+            );
+        }
+    }
+}
+
+/// The pruned Dijkstra's costs are the shortest lattice distances: every reached cell's cost
+/// is no more than any neighbour's plus the move (so no improving relaxation was skipped), and
+/// equals one of them (or is the start's 0). The searches on `u32` and `u64` words find the
+/// same costs (four searches from different starts on one thread: the `u32` words' marks run
+/// out after three and the words are cleared).
+#[test]
+fn pruned_searches_keep_every_cost_shortest() {
+    let mut rng = ChaCha8Rng::seed_from_u64(12);
+    for _ in 0..3 {
+        let grid = boxes_in_a_room(&mut rng).grid(0.15);
+        let lattice = grid.lattice();
+        let open: Vec<usize> = (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect();
+        let starts: Vec<usize> = (0..4)
+            .map(|_| open[rng.random_range(0..open.len())])
+            .collect();
+        for &start in &starts[1..] {
+            assert_eq!(
+                best_first::all_costs(lattice, start, false),
+                best_first::all_costs(lattice, start, true),
+                "from cell {start}"
+            );
+        }
+        let start = starts[0];
+        let costs = best_first::all_costs(lattice, start, false);
+        let mut reached = 0;
+        for cell in (0..lattice.len()).filter(|&c| costs[c] != u64::MAX) {
+            reached += 1;
+            let mut allowed = lattice.allowed_moves(cell);
+            let mut via = u64::MAX;
+            while allowed != 0 {
+                let mv = &lattice.moves()[allowed.trailing_zeros() as usize];
+                allowed &= allowed - 1;
+                let next = cell.wrapping_add_signed(mv.offset);
+                assert!(costs[next] <= costs[cell] + mv.cost, "cell {cell}");
+                // Moves are symmetric: `next` reaches `cell` by the opposite move.
+                via = via.min(costs[next].saturating_add(mv.cost));
+            }
+            assert!(cell == start || costs[cell] == via, "cell {cell}");
+        }
+        assert!(reached > 1000, "{reached} cells reached");
+    }
+}
+
+/// Attaching a point by looking at the cells nearest first finds what the scan of the whole
+/// cube finds: the same cell, or none, for points open, blocked, in unknown space and outside
+/// the map, with the radii of starts and goals.
+#[test]
+fn nearest_first_attachment_agrees_with_the_full_scan() {
+    use super::search::{Around, attach, attach_by_scan};
+    let mut rng = ChaCha8Rng::seed_from_u64(5);
+    let (mut open, mut blocked, mut none) = (0, 0, 0);
+    for _ in 0..3 {
+        let mut map = boxes_in_a_room(&mut rng);
+        // A slab of unknown space, as frontier goals face.
+        map.fill(
+            IVec3::new(0, 0, 10),
+            IVec3::new(47, 20, 14),
+            uavex_components::map::UNKNOWN_LOG_ODDS,
+        );
+        let grid = map.grid(0.15);
+        for i in 0..600 {
+            // Random points, and corners shared by cells, as near to several centres as to
+            // any (ties broken by index).
+            let point = if i % 3 == 0 {
+                DVec3::new(
+                    0.2 * rng.random_range(0..24) as f64,
+                    0.2 * rng.random_range(0..24) as f64,
+                    0.2 * rng.random_range(0..12) as f64,
+                )
+            } else {
+                DVec3::new(
+                    rng.random_range(-0.6..5.4),
+                    rng.random_range(-0.6..5.4),
+                    rng.random_range(-0.4..2.8),
+                )
+            };
+            for radius in [SNAP_RADIUS_M, super::search::GOAL_SNAP_RADIUS_M] {
+                let around = Around::of(&grid, point, radius).unwrap();
+                let expected = attach_by_scan(&grid, point, radius, &around);
+                assert_eq!(attach(&grid, point, radius), expected, "{point} {radius}");
+                match expected {
+                    Some(end) if end.traversable => open += 1,
+                    Some(_) => blocked += 1,
+                    None => none += 1,
+                }
+            }
+        }
+    }
+    assert!(
+        open > 100 && blocked > 100 && none > 100,
+        "{open} {blocked} {none}"
+    );
+}
+
+#[test]
+fn a_blocked_start_is_attached_to_the_nearest_open_cell() {
+    let mut map = wall_room();
+    let grid = map.grid(0.27);
+    // 0.2 m from the wall's face (x = 3.0): inside the inflation.
+    let start = DVec3::new(2.85, 1.0, 0.8);
+    assert!(!grid.is_traversable_point(start));
+    let path = find_path(&grid, start, DVec3::new(1.0, 1.0, 0.8), usize::MAX).unwrap();
+    assert_eq!(path[0], start);
+    assert!(path[1].distance(start) <= SNAP_RADIUS_M);
+    assert!(path[1..].windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    // A goal inside the inflation ends at the nearest open cell's centre instead.
+    let path = find_path(&grid, DVec3::new(1.0, 1.0, 0.8), start, usize::MAX).unwrap();
+    let end = *path.last().unwrap();
+    assert!(grid.is_traversable_point(end) && end.distance(start) <= SNAP_RADIUS_M);
+    // Far outside the map: no open cell within reach.
+    assert_eq!(
+        find_path(&grid, DVec3::new(8.0, 1.0, 0.8), end, usize::MAX),
+        None
+    );
+}

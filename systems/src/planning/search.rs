@@ -42,6 +42,8 @@ pub(super) struct Endpoint {
     pub(super) traversable: bool,
 }
 
+/// Where `point` joins the lattice (module doc): the open cell nearest to it within `radius`
+/// (by distance, then cell index), or for a traversable point the nearest one it sees.
 pub(super) fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Option<Endpoint> {
     let around = Around::of(grid, point, radius)?;
     match nearest_open(grid, point, &around, radius) {
@@ -177,12 +179,12 @@ fn nearest_first() -> &'static [(f64, IVec3)] {
     })
 }
 
-/// The open cell nearest to `point` within `radius`, by distance then cell index, as
-/// [`attach_by_scan`] orders its candidates, found by looking at the
-/// cells around `home` nearest first and stopping once no farther one can be nearer: the
-/// nearest open cell is mostly a few cells away, and the scan looked at the whole cube of
-/// `n` cells around `home` (some 1,000 cells for a goal). A cell at offset `d` lies at least
-/// `|d| 2 resolution - |point - centre(home)|` from the point (triangle inequality; a
+/// The open cell nearest to `point` within `radius`, by distance then cell index (the order
+/// in which [`attach_by_scan`] takes its candidates), found by looking at the cells around
+/// the point's nearest first and stopping once no farther one can be nearer. The nearest open
+/// cell is mostly a few cells away, where the scan looks at the whole cube around the point's
+/// cell (some 1,000 cells for a goal). A cell at offset `d` from the point's cell lies at
+/// least `|d| 2 resolution - |point - centre|` from the point (triangle inequality; a
 /// nanometre of margin for rounding).
 fn nearest_open(grid: &TraversableGrid, point: DVec3, around: &Around, radius: f64) -> Nearest {
     let Around { home, n, .. } = *around;

@@ -450,8 +450,9 @@ fn expand<const ASTAR: bool, W: Word>(
     let base = nodes.reached_base();
     let mut allowed = lattice.allowed_moves(index);
     if let Some(arrival) = nodes.arrival(index).filter(|_| prune) {
-        let parent = || index.wrapping_add_signed(-moves[arrival].offset);
-        allowed &= !dominated(arrival, allowed, || lattice.allowed_moves(parent()));
+        let parent_allowed =
+            || lattice.allowed_moves(index.wrapping_add_signed(-moves[arrival].offset));
+        allowed &= !dominated(arrival, allowed, parent_allowed);
     }
     while allowed != 0 {
         let k = allowed.trailing_zeros();

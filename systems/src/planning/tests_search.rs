@@ -215,6 +215,11 @@ fn boxes_in_a_room(rng: &mut ChaCha8Rng) -> TestMap {
     map
 }
 
+/// The open cells of a lattice, by index.
+fn open_cells(lattice: &lattice::Lattice) -> Vec<usize> {
+    (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect()
+}
+
 /// Skipping the moves that cannot lower a cost changes nothing a search does: the pruned
 /// Dijkstra closes the same cells in the same order, with the same costs and arrivals, as
 /// the one that relaxes every move. The rooms have both cells with all 26 neighbours open
@@ -226,7 +231,7 @@ fn pruning_changes_no_cost_arrival_or_order() {
     for _ in 0..3 {
         let grid = boxes_in_a_room(&mut rng).grid(0.15);
         let lattice = grid.lattice();
-        let open: Vec<usize> = (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect();
+        let open = open_cells(lattice);
         let surrounded = open
             .iter()
             .filter(|&&c| lattice.allowed_moves(c).count_ones() == 26)
@@ -259,7 +264,7 @@ fn pruned_searches_keep_every_cost_shortest() {
     for _ in 0..3 {
         let grid = boxes_in_a_room(&mut rng).grid(0.15);
         let lattice = grid.lattice();
-        let open: Vec<usize> = (0..lattice.len()).filter(|&c| lattice.is_open(c)).collect();
+        let open = open_cells(lattice);
         let starts: Vec<usize> = (0..4)
             .map(|_| open[rng.random_range(0..open.len())])
             .collect();

@@ -11,7 +11,9 @@ mod hold;
 mod polynomial;
 
 pub use hold::Hold;
-pub use polynomial::{POLYNOMIAL_COEFFICIENTS, PiecewisePolynomial, PolynomialSegment};
+pub use polynomial::{
+    POLYNOMIAL_COEFFICIENTS, PiecewisePolynomial, PolynomialSegment, PreparedPolynomial,
+};
 
 use glam::DVec3;
 use serde::{Deserialize, Serialize};
@@ -66,5 +68,12 @@ pub trait Trajectory: Send + Sync + std::fmt::Debug {
     /// positions only).
     fn position(&self, t: f64) -> DVec3 {
         self.sample(t).position
+    }
+
+    /// This trajectory in a form that is cheaper to sample many times over, the same to the
+    /// bit, if the implementation has one (a rollout samples its reference 100 times a
+    /// second); `None` when sampling `self` is as cheap as it gets.
+    fn prepared(&self) -> Option<Box<dyn Trajectory + '_>> {
+        None
     }
 }

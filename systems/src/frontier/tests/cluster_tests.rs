@@ -1,6 +1,6 @@
 //! Divisive 2-means (eaae.md step 2): the stop rule, the partition, determinism.
 
-use super::super::cluster::centroid_and_radius;
+use super::super::cluster::{LLOYD_ITERATIONS, centroid_and_radius};
 use super::super::*;
 use glam::Vec3;
 use proptest::prelude::*;
@@ -115,5 +115,111 @@ proptest! {
             .map(|&(x, y, z)| (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * 0.1)
             .collect();
         check(&points, 2.731_512, seed);
+    }
+}
+
+/// The divisive 2-means of eaae.md step 2 written plainly: points as `Vec3`s, every sum
+/// formed from scratch in order, the same seeding and stop rules.
+fn plain_two_means(points: &[Vec3], bound: f32, rng: &mut impl rand::Rng) -> Vec<Cluster> {
+    let sum = |pts: &[Vec3], keep: &dyn Fn(usize) -> bool| {
+        (0..pts.len())
+            .filter(|&j| keep(j))
+            .fold(glam::DVec3::ZERO, |s, j| s + pts[j].as_dvec3())
+    };
+    let farthest = |pts: &[Vec3], from: Vec3| {
+        pts.iter().fold((from, 0.0f32), |best, &p| {
+            let d = p.distance_squared(from);
+            if d > best.1 { (p, d) } else { best }
+        })
+    };
+    let mut out = Vec::new();
+    let mut stack = vec![(0..points.len()).collect::<Vec<usize>>()];
+    while let Some(members) = stack.pop() {
+        let pts: Vec<Vec3> = members.iter().map(|&m| points[m]).collect();
+        let centroid = (sum(&pts, &|_| true) / pts.len() as f64).as_vec3();
+        let r2 = pts
+            .iter()
+            .map(|p| p.distance_squared(centroid))
+            .fold(0.0f32, f32::max);
+        if members.len() == 1 || r2.sqrt() <= bound {
+            out.push(Cluster {
+                centroid,
+                members,
+                r_max: r2.sqrt(),
+            });
+            continue;
+        }
+        let r = pts[rng.random_range(0..pts.len())];
+        let (a, _) = farthest(&pts, r);
+        let (b, d) = farthest(&pts, a);
+        assert!(d > 0.0, "these tests' points are distinct");
+        let (mut centres, mut side) = ([a, b], vec![false; pts.len()]);
+        for iteration in 0..LLOYD_ITERATIONS {
+            let w = centres[1] - centres[0];
+            let t = 0.5 * (centres[1].length_squared() - centres[0].length_squared());
+            let next: Vec<bool> = pts.iter().map(|p| p.dot(w) > t).collect();
+            let count1 = next.iter().filter(|&&s| s).count();
+            if count1 == 0 || count1 == pts.len() {
+                break;
+            }
+            let unchanged = next == side;
+            side = next;
+            if iteration > 0 && unchanged {
+                break;
+            }
+            let sum1 = sum(&pts, &|j| side[j]);
+            let count0 = pts.len() - count1;
+            centres = [
+                ((sum(&pts, &|_| true) - sum1) / count0 as f64).as_vec3(),
+                (sum1 / count1 as f64).as_vec3(),
+            ];
+        }
+        let half = |s: bool| {
+            (0..pts.len())
+                .filter(|&j| side[j] == s)
+                .map(|j| members[j])
+                .collect()
+        };
+        stack.push(half(true));
+        stack.push(half(false));
+    }
+    out
+}
+
+/// The clustering keeps its sums in partial sums per lane and updates a side's sum by the
+/// points that changed side (`cluster::Coordinates`): the same clusters, bit for bit, as the
+/// plain algorithm's on frontiers of voxel centres (whose sums are exact in any order).
+#[test]
+fn clusters_equal_the_plain_algorithm_to_the_bit() {
+    use rand::Rng;
+    for case in 0..40u64 {
+        let mut rng = ChaCha8Rng::seed_from_u64(case);
+        let n = rng.random_range(2..3000);
+        let mut keys = std::collections::BTreeSet::new();
+        while keys.len() < n {
+            keys.insert((
+                rng.random_range(-100..100),
+                rng.random_range(-100..100),
+                rng.random_range(0..30),
+            ));
+        }
+        let centre = |k: i32| (k as f32 + 0.5) * 0.1;
+        let points: Vec<Vec3> = keys
+            .iter()
+            .map(|&(x, y, z)| Vec3::new(centre(x), centre(y), centre(z)))
+            .collect();
+        let bound = 0.3 + case as f32 * 0.07;
+        let rng = |case| ChaCha8Rng::seed_from_u64(case + 1000);
+        let fast = divisive_two_means(&points, bound, &mut rng(case));
+        let plain = plain_two_means(&points, bound, &mut rng(case));
+        assert_eq!(fast.len(), plain.len(), "case {case}");
+        for (f, p) in fast.iter().zip(&plain) {
+            assert_eq!(f.members, p.members, "case {case}");
+            assert_eq!(
+                f.centroid.to_array().map(f32::to_bits),
+                p.centroid.to_array().map(f32::to_bits)
+            );
+            assert_eq!(f.r_max.to_bits(), p.r_max.to_bits(), "case {case}");
+        }
     }
 }

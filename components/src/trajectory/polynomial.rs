@@ -65,17 +65,7 @@ impl PolynomialSegment {
         let z = self.derivatives(Z, tau);
         // A reference carries the yaw up to its acceleration.
         let yaw: [f64; 3] = self.first_derivatives(YAW, tau);
-        let v = |n: usize| DVec3::new(x[n], y[n], z[n]);
-        TrajectoryPoint {
-            position: v(0),
-            velocity: v(1),
-            acceleration: v(2),
-            jerk: v(3),
-            snap: v(4),
-            yaw: yaw[0],
-            yaw_rate: yaw[1],
-            yaw_acceleration: yaw[2],
-        }
+        reference(|n| DVec3::new(x[n], y[n], z[n]), yaw)
     }
 
     /// The position at normalised time `tau`: [`Self::point`]'s, bit for bit.
@@ -85,6 +75,22 @@ impl PolynomialSegment {
         let [y] = self.first_derivatives(Y, tau);
         let [z] = self.first_derivatives(Z, tau);
         DVec3::new(x, y, z)
+    }
+}
+
+/// A reference from the position's derivatives of orders 0 to 4 (`derivative(n)`) and the
+/// yaw's of orders 0 to 2.
+#[inline(always)]
+fn reference(derivative: impl Fn(usize) -> DVec3, yaw: [f64; 3]) -> TrajectoryPoint {
+    TrajectoryPoint {
+        position: derivative(0),
+        velocity: derivative(1),
+        acceleration: derivative(2),
+        jerk: derivative(3),
+        snap: derivative(4),
+        yaw: yaw[0],
+        yaw_rate: yaw[1],
+        yaw_acceleration: yaw[2],
     }
 }
 
@@ -260,17 +266,8 @@ impl PreparedSegment {
 
     fn point(&self, tau: f64) -> TrajectoryPoint {
         let d: [[f64; 4]; ORDERS] = self.derivatives(tau);
-        let v = |n: usize| DVec3::new(d[n][X], d[n][Y], d[n][Z]);
-        TrajectoryPoint {
-            position: v(0),
-            velocity: v(1),
-            acceleration: v(2),
-            jerk: v(3),
-            snap: v(4),
-            yaw: d[0][YAW],
-            yaw_rate: d[1][YAW],
-            yaw_acceleration: d[2][YAW],
-        }
+        let yaw = [d[0][YAW], d[1][YAW], d[2][YAW]];
+        reference(|n| DVec3::new(d[n][X], d[n][Y], d[n][Z]), yaw)
     }
 
     fn position(&self, tau: f64) -> DVec3 {

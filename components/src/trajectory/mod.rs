@@ -70,6 +70,14 @@ pub trait Trajectory: Send + Sync + std::fmt::Debug {
         self.sample(t).position
     }
 
+    /// The position at time `t` ([`Self::position`], bit for bit), for a caller that samples
+    /// forward in time: `segment` is the implementation's to keep between calls (start it at
+    /// 0), e.g. where the last time was found, so that the next one is found from there.
+    fn position_onward(&self, t: f64, segment: &mut usize) -> DVec3 {
+        let _ = segment;
+        self.position(t)
+    }
+
     /// This trajectory in a form that is cheaper to sample many times over, the same to the
     /// bit, if the implementation has one (a rollout samples its reference 100 times a
     /// second); `None` when sampling `self` is as cheap as it gets.

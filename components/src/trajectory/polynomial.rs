@@ -201,6 +201,23 @@ impl Trajectory for PiecewisePolynomial {
         let (index, tau) = self.locate(t);
         self.segments[index].position(tau)
     }
+
+    /// [`Self::position`], the segment found from the last one onward (`segment`) instead of
+    /// by a binary search: the same segment, since the knots increase.
+    fn position_onward(&self, t: f64, segment: &mut usize) -> DVec3 {
+        let last = self.segments.len() - 1;
+        let mut index = (*segment).min(last);
+        if t >= self.duration() || t.is_nan() || self.knots[index] > t {
+            // Past the end, before the hint (or not a number): as `position` does.
+            return self.position(t);
+        }
+        while index < last && self.knots[index + 1] <= t {
+            index += 1;
+        }
+        *segment = index;
+        let tau = (t - self.knots[index]) / self.segments[index].duration;
+        self.segments[index].position(tau.clamp(0.0, 1.0))
+    }
 }
 
 /// A [`PiecewisePolynomial`] made ready for many samples (a rollout takes 100 a second, a
@@ -360,8 +377,8 @@ mod tests {
         assert_eq!(trajectory.sample(-1.0).position, DVec3::ZERO);
     }
 
-    /// Positions alone, the yaw up to its acceleration alone, and the prepared form's samples
-    /// are the full sample's to the bit: in every segment, at the knots, before the start and
+    /// Positions alone (also sampled onward), the yaw up to its acceleration alone, and the
+    /// prepared form's samples are the full sample's to the bit: in every segment, at the knots, before the start and
     /// past the end.
     #[test]
     fn positions_yaw_and_prepared_samples_equal_the_full_computation_to_the_bit() {
@@ -418,6 +435,20 @@ mod tests {
             );
         }
         assert_eq!(prepared.duration(), end);
+        // Positions sampled onward, the segment kept between calls, and at times that go back
+        // or are not numbers.
+        let times = (0..=997).map(|i| -0.1 + (end + 0.3) * f64::from(i) / 997.0);
+        let knots = trajectory.knots().to_vec();
+        for times in [times.collect(), knots, vec![2.0, 0.5, f64::NAN, 1.0]] {
+            let mut segment = 0;
+            for t in times {
+                assert_eq!(
+                    bits(trajectory.position_onward(t, &mut segment)),
+                    bits(trajectory.position(t)),
+                    "t = {t}"
+                );
+            }
+        }
         assert!(trajectory.prepared().is_some());
         for tau in (0..=100).map(|i| f64::from(i) / 100.0) {
             let segment = &trajectory.segments()[1];

@@ -16,7 +16,7 @@ use super::search::SNAP_RADIUS_M;
 use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
 use crate::mapping::OccupancyMap;
-use glam::DVec3;
+use glam::{DVec3, IVec3};
 use uavex_components::trajectory::Trajectory;
 
 /// The first sample from `t0` on that breaks the traversability (with the escape rule of the
@@ -35,9 +35,22 @@ pub fn first_untraversable(
     };
     let origin = trajectory.position(t0.clamp(0.0, end));
     let mut escaping = !grid.is_traversable_point(origin);
+    // Samples 5 cm apart fall in the same 0.1 m voxel half the time: its answer is kept.
+    let mut last: Option<(IVec3, bool)> = None;
+    let mut traversable = |p: DVec3| {
+        if !p.is_finite() {
+            return false;
+        }
+        let key = grid.key_of(p);
+        match last {
+            Some((seen, answer)) if seen == key => answer,
+            _ => last.insert((key, grid.is_traversable(key))).1,
+        }
+    };
+    let mut segment = 0;
     for t in times {
-        let p = trajectory.position(t);
-        if grid.is_traversable_point(p) {
+        let p = trajectory.position_onward(t, &mut segment);
+        if traversable(p) {
             escaping = false;
         } else if !escaping || p.distance(origin) > SNAP_RADIUS_M {
             return Some((t, p));

@@ -175,6 +175,23 @@ impl PiecewisePolynomial {
     }
 }
 
+impl PiecewisePolynomial {
+    /// Where time `t` falls ([`Self::locate`]); `None` at or past the end, where the trajectory
+    /// holds its end point at rest.
+    fn within(&self, t: f64) -> Option<(usize, f64)> {
+        if t >= self.duration() {
+            None
+        } else {
+            Some(self.locate(t))
+        }
+    }
+}
+
+/// The reference held after a trajectory's end: its end point, at rest.
+fn held_end(end: TrajectoryPoint) -> TrajectoryPoint {
+    TrajectoryPoint::at_rest(end.position, end.yaw)
+}
+
 impl Trajectory for PiecewisePolynomial {
     fn duration(&self) -> f64 {
         self.knots[self.segments.len()]
@@ -185,20 +202,15 @@ impl Trajectory for PiecewisePolynomial {
     }
 
     fn sample(&self, t: f64) -> TrajectoryPoint {
-        if t >= self.duration() {
-            let end = self.segments[self.segments.len() - 1].point(1.0);
-            return TrajectoryPoint::at_rest(end.position, end.yaw);
+        match self.within(t) {
+            Some((index, tau)) => self.segments[index].point(tau),
+            None => held_end(self.segments[self.segments.len() - 1].point(1.0)),
         }
-        let (index, tau) = self.locate(t);
-        self.segments[index].point(tau)
     }
 
     /// The position only: a fifth of the work of a sample (collision checks every 5 cm).
     fn position(&self, t: f64) -> DVec3 {
-        if t >= self.duration() {
-            return self.segments[self.segments.len() - 1].position(1.0);
-        }
-        let (index, tau) = self.locate(t);
+        let (index, tau) = self.within(t).unwrap_or((self.segments.len() - 1, 1.0));
         self.segments[index].position(tau)
     }
 
@@ -312,19 +324,15 @@ impl Trajectory for PreparedPolynomial<'_> {
     }
 
     fn sample(&self, t: f64) -> TrajectoryPoint {
-        if t >= self.duration() {
-            let end = self.segments[self.segments.len() - 1].point(1.0);
-            return TrajectoryPoint::at_rest(end.position, end.yaw);
+        match self.polynomial.within(t) {
+            Some((index, tau)) => self.segments[index].point(tau),
+            None => held_end(self.segments[self.segments.len() - 1].point(1.0)),
         }
-        let (index, tau) = self.polynomial.locate(t);
-        self.segments[index].point(tau)
     }
 
     fn position(&self, t: f64) -> DVec3 {
-        if t >= self.duration() {
-            return self.segments[self.segments.len() - 1].position(1.0);
-        }
-        let (index, tau) = self.polynomial.locate(t);
+        let end = (self.segments.len() - 1, 1.0);
+        let (index, tau) = self.polynomial.within(t).unwrap_or(end);
         self.segments[index].position(tau)
     }
 }
@@ -378,8 +386,8 @@ mod tests {
     }
 
     /// Positions alone (also sampled onward), the yaw up to its acceleration alone, and the
-    /// prepared form's samples are the full sample's to the bit: in every segment, at the knots, before the start and
-    /// past the end.
+    /// prepared form's samples are the full sample's to the bit: in every segment, at the
+    /// knots, before the start and past the end.
     #[test]
     fn positions_yaw_and_prepared_samples_equal_the_full_computation_to_the_bit() {
         // Awkward coefficients and durations (no exact binary fractions), three segments.

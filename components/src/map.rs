@@ -16,11 +16,12 @@ mod chunk;
 mod config;
 mod grid;
 mod index;
+mod rows;
 mod saturation;
 mod stats;
 
 pub use chunk::{
-    CHUNK_EDGE, CHUNK_VOXELS, ChunkCoord, RowStates, ScanId, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk,
+    CHUNK_EDGE, CHUNK_VOXELS, ChunkCells, ChunkCoord, ScanId, UNKNOWN_LOG_ODDS, Voxel, VoxelChunk,
     VoxelState, local_index, local_key,
 };
 pub use config::{
@@ -29,6 +30,7 @@ pub use config::{
 };
 pub use grid::ChunkGrid;
 pub use index::{ChunkIndex, ScanCounter};
+pub use rows::{CHUNK_ROWS, ChunkRows, RowStates};
 pub use saturation::{
     BRICK_EDGE, BRICK_VOXELS, BrickSaturation, CHUNK_BRICKS, block_bricks, brick_of,
 };

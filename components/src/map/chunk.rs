@@ -1,5 +1,6 @@
 //! Voxel chunks: fixed 16^3 blocks of voxels, each one ECS entity (common.md §1, "Chunks").
 
+use super::rows::{ChunkRows, RowStates};
 use super::saturation::BrickSaturation;
 use bevy_ecs::prelude::*;
 use glam::IVec3;
@@ -157,22 +158,6 @@ impl Voxel {
     }
 }
 
-/// The states of the 16 voxels of one x-row of a chunk, bit x for voxel x
-/// ([`VoxelChunk::row_states`]).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct RowStates {
-    pub unknown: u16,
-    pub occupied: u16,
-}
-
-impl RowStates {
-    /// The free voxels: known and not occupied.
-    #[inline]
-    pub fn free(self) -> u16 {
-        !(self.unknown | self.occupied)
-    }
-}
-
 /// The voxels of one chunk, indexed by [`local_index`], plus the stamp epoch and, per brick,
 /// how many of its voxels are saturated free.
 ///
@@ -184,7 +169,7 @@ impl RowStates {
 /// **Saturation.** A miss cannot change a voxel already at the lower clamping bound, so the map
 /// update crosses saturated bricks (and blocks and chunks of them) without visiting their
 /// voxels ([`BrickSaturation`]). The map update keeps the counts
-/// ([`Self::voxels_and_saturation_mut`]); writes through [`Self::voxels_mut`] forget them.
+/// ([`Self::voxels_for_update`]); writes through [`Self::voxels_mut`] forget them.
 ///
 /// **State version.** Most updates only move a voxel's log-odds within its state (a free voxel
 /// seen free again); frontiers and traversability depend on the states alone (unknown, free,
@@ -194,14 +179,60 @@ impl RowStates {
 /// (`uavex_systems::mapping::StateChanges`). The chunk also remembers *where* the last scan
 /// that changed states here changed them ([`Self::state_changed_bricks_since`]), so that they
 /// re-examine only the neighbours those bricks can reach.
-#[derive(Component, Debug, Clone, PartialEq, Eq)]
+///
+/// **Row states.** The states of the voxels by x-row ([`Self::row_states`]), which frontiers
+/// and traversability read by the thousand, are kept as bits beside the voxels
+/// ([`ChunkCells`], [`super::rows`]): the map update sets a voxel's bits when it changes its
+/// state; after a write through [`Self::voxels_mut`] rows are read from the voxels until the
+/// map update's next write rebuilds them.
+#[derive(Component, Debug, Clone)]
 pub struct VoxelChunk {
-    voxels: Box<[Voxel; CHUNK_VOXELS]>,
+    cells: Box<ChunkCells>,
     epoch: u32,
     saturation: BrickSaturation,
     state_version: u32,
     state_log: StateLog,
+    /// A write through [`Self::voxels_mut`] left the cells' rows behind: rows are read from
+    /// the voxels until the map update's next write rebuilds them.
+    rows_stale: bool,
 }
+
+/// A chunk's voxels and their states by row, in one allocation: the map update reaches the
+/// rows at a fixed offset from the voxels it writes (no pointer more to keep in its walk,
+/// whose every register counts).
+#[derive(Debug, Clone)]
+pub struct ChunkCells {
+    voxels: [Voxel; CHUNK_VOXELS],
+    rows: ChunkRows,
+}
+
+impl ChunkCells {
+    /// Voxel `index` (a local index, taken modulo [`CHUNK_VOXELS`]).
+    #[inline(always)]
+    pub fn voxel_mut(&mut self, index: usize) -> &mut Voxel {
+        &mut self.voxels[index % CHUNK_VOXELS]
+    }
+
+    /// Voxel `index` now holds the state `occupied` (or free, if not): see
+    /// [`ChunkRows::set_known`].
+    #[inline(always)]
+    pub fn set_known(&mut self, index: usize, occupied: bool) {
+        self.rows.set_known(index, occupied);
+    }
+}
+
+/// Equal voxels, stamps, saturation and state history; the row states follow from the voxels.
+impl PartialEq for VoxelChunk {
+    fn eq(&self, other: &Self) -> bool {
+        self.cells.voxels == other.cells.voxels
+            && self.epoch == other.epoch
+            && self.saturation == other.saturation
+            && self.state_version == other.state_version
+            && self.state_log == other.state_log
+    }
+}
+
+impl Eq for VoxelChunk {}
 
 /// The bricks (bit `b` for brick `b`, as [`super::brick_of`] numbers them) in which the scan
 /// `scan` (a raw [`ScanId`], 0 for none) changed voxel states, and the state version before its
@@ -223,11 +254,15 @@ impl VoxelChunk {
     /// A chunk of unknown voxels.
     pub fn new() -> Self {
         Self {
-            voxels: Box::new([Voxel::UNKNOWN; CHUNK_VOXELS]),
+            cells: Box::new(ChunkCells {
+                voxels: [Voxel::UNKNOWN; CHUNK_VOXELS],
+                rows: ChunkRows::UNKNOWN,
+            }),
             epoch: 0,
             saturation: BrickSaturation::NONE,
             state_version: 0,
             state_log: StateLog::default(),
+            rows_stale: false,
         }
     }
 
@@ -247,17 +282,19 @@ impl VoxelChunk {
 
     #[inline]
     pub fn voxels(&self) -> &[Voxel; CHUNK_VOXELS] {
-        &self.voxels
+        &self.cells.voxels
     }
 
     /// Mutable voxels, for tools and tests that write a map by hand. Forgets the saturation
-    /// counts (they stay a lower bound whatever is written) and bumps the state version (any
-    /// state may change); the map update uses [`Self::voxels_and_saturation_mut`] instead.
+    /// counts (they stay a lower bound whatever is written) and the row states (read from the
+    /// voxels until the map update writes again), and bumps the state version (any state may
+    /// change); the map update uses [`Self::voxels_for_update`] instead.
     #[inline]
     pub fn voxels_mut(&mut self) -> &mut [Voxel; CHUNK_VOXELS] {
         self.saturation.forget();
         self.note_state_change();
-        &mut self.voxels
+        self.rows_stale = true;
+        &mut self.cells.voxels
     }
 
     /// A counter that changes whenever some voxel's state may have changed (see the type's
@@ -274,7 +311,7 @@ impl VoxelChunk {
     }
 
     /// Records that scan `scan` changed the states of voxels in `bricks` (a set of brick bits;
-    /// the map update calls it after writing through [`Self::voxels_and_saturation_mut`], once
+    /// the map update calls it after writing through [`Self::voxels_for_update`], once
     /// per visit of the chunk).
     #[inline]
     pub fn note_state_changes_in(&mut self, scan: ScanId, bricks: u64) {
@@ -305,13 +342,15 @@ impl VoxelChunk {
         }
     }
 
-    /// Mutable voxels and the saturation of their bricks, for the map update, which keeps the
-    /// counts (and [`super::ChunkStats`]) in step with every write.
+    /// Mutable voxels with their row states, and the saturation of their bricks, for the map
+    /// update, which keeps the rows, the counts (and [`super::ChunkStats`]) in step with every
+    /// write.
     #[inline]
-    pub fn voxels_and_saturation_mut(
-        &mut self,
-    ) -> (&mut [Voxel; CHUNK_VOXELS], &mut BrickSaturation) {
-        (&mut self.voxels, &mut self.saturation)
+    pub fn voxels_for_update(&mut self) -> (&mut ChunkCells, &mut BrickSaturation) {
+        if std::mem::take(&mut self.rows_stale) {
+            self.cells.rows = ChunkRows::of(&self.cells.voxels);
+        }
+        (&mut self.cells, &mut self.saturation)
     }
 
     /// Which bricks are saturated free.
@@ -326,31 +365,28 @@ impl VoxelChunk {
     #[inline]
     pub fn row_bits(&self, row: usize, pred: impl Fn(Voxel) -> bool) -> u16 {
         let start = (row * CHUNK_EDGE as usize) % CHUNK_VOXELS;
-        self.voxels[start..start + CHUNK_EDGE as usize]
+        self.cells.voxels[start..start + CHUNK_EDGE as usize]
             .iter()
             .enumerate()
             .fold(0u16, |bits, (x, &v)| bits | (u16::from(pred(v)) << x))
     }
 
-    /// The states of the voxels of row `row` (as [`Self::row_bits`]) in one pass: frontiers
-    /// and traversability need two of the three states of every row they read, and one pass
-    /// reads the voxels once.
+    /// The states of the voxels of row `row` (as [`Self::row_bits`]), kept as bits by the map
+    /// update ([`super::rows`]).
     #[inline]
     pub fn row_states(&self, row: usize) -> RowStates {
-        let start = (row * CHUNK_EDGE as usize) % CHUNK_VOXELS;
-        let voxels = &self.voxels[start..start + CHUNK_EDGE as usize];
-        let (mut unknown, mut occupied) = (0u16, 0u16);
-        for (x, v) in voxels.iter().enumerate() {
-            unknown |= u16::from(v.is_unknown()) << x;
-            occupied |= u16::from(v.is_occupied()) << x;
+        if self.rows_stale {
+            let start = (row * CHUNK_EDGE as usize) % CHUNK_VOXELS;
+            RowStates::of(&self.cells.voxels[start..start + CHUNK_EDGE as usize])
+        } else {
+            self.cells.rows.get(row)
         }
-        RowStates { unknown, occupied }
     }
 
     /// Stored log-odds (milli units) at local index `index`.
     #[inline]
     pub fn log_odds_milli(&self, index: usize) -> i16 {
-        self.voxels[index % CHUNK_VOXELS].log_odds
+        self.cells.voxels[index % CHUNK_VOXELS].log_odds
     }
 
     #[inline]
@@ -367,7 +403,7 @@ impl VoxelChunk {
     pub fn begin_scan(&mut self, scan: ScanId) {
         if self.epoch != scan.epoch() {
             self.epoch = scan.epoch();
-            for voxel in self.voxels.iter_mut() {
+            for voxel in self.cells.voxels.iter_mut() {
                 voxel.stamp = 0;
             }
         }
@@ -375,7 +411,8 @@ impl VoxelChunk {
 
     /// Number of voxels that are not unknown.
     pub fn known_count(&self) -> usize {
-        self.voxels
+        self.cells
+            .voxels
             .iter()
             .filter(|v| v.log_odds != UNKNOWN_LOG_ODDS)
             .count()
@@ -512,7 +549,7 @@ mod tests {
     #[test]
     fn writing_voxels_by_hand_forgets_saturation_and_bumps_the_state_version() {
         let mut chunk = VoxelChunk::new();
-        let saturation = chunk.voxels_and_saturation_mut().1;
+        let saturation = chunk.voxels_for_update().1;
         for _ in 0..BRICK_VOXELS {
             saturation.add(3);
         }

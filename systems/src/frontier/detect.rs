@@ -16,7 +16,7 @@
 use super::super::mapping::{OccupancyMap, StateChange};
 use glam::IVec3;
 use uavex_components::frontier::{FrontierSet, VoxelMask};
-use uavex_components::map::{CHUNK_EDGE, ChunkCoord, Voxel, VoxelChunk, VoxelState};
+use uavex_components::map::{CHUNK_EDGE, ChunkCoord, VoxelChunk, VoxelState};
 
 /// Padded edge: the chunk's 16 voxels plus one neighbour layer on each side.
 const PADDED: usize = CHUNK_EDGE as usize + 2;
@@ -45,15 +45,9 @@ pub const NEIGHBOURS: [IVec3; 6] = [
     IVec3::Z,
 ];
 
-/// Bits `x` of the voxels of row (y, z) of `chunk` for which `pred` holds.
-#[inline]
-fn row_bits(chunk: &VoxelChunk, y: usize, z: usize, pred: impl Fn(Voxel) -> bool) -> u16 {
-    chunk.row_bits(y + EDGE * z, pred)
-}
-
 /// Unknown bits of row (y, z) of a neighbour chunk; a chunk never created is all unknown.
 fn unknown_row(chunk: Option<&VoxelChunk>, y: usize, z: usize) -> u16 {
-    chunk.map_or(u16::MAX, |c| row_bits(c, y, z, Voxel::is_unknown))
+    chunk.map_or(u16::MAX, |c| c.row_states(y + EDGE * z).unknown)
 }
 
 /// Whether voxel (x, y, z) of a neighbour chunk is unknown.

@@ -200,12 +200,12 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let (chunk, stats) = self.chunks.chunk_mut(flat, coord);
         chunk.begin_scan(self.scan);
         let before = *stats;
-        let (voxels, saturation) = chunk.voxels_and_saturation_mut();
+        let (cells, saturation) = chunk.voxels_for_update();
         let (mut visits, mut changed, mut state_bricks) = (0, 0, 0u64);
         for key in keys {
             debug_assert_eq!(ChunkCoord::of_key(key), coord);
             let index = local_index(key) & (CHUNK_VOXELS - 1);
-            let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
+            let change = update_voxel(cells, index, saturation, rule, self.tables, stats);
             visits += 1;
             changed += u64::from(change.changed());
             state_bricks |= u64::from(change.state_changed()) << brick_of(index);
@@ -418,7 +418,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             }
             chunk.begin_scan(self.scan);
             let before = *stats;
-            let (voxels, saturation) = chunk.voxels_and_saturation_mut();
+            let (cells, saturation) = chunk.voxels_for_update();
             let mut cursor = Cursor::at(key);
             let mut changed = 0u64;
             let mut skipped = 0u64;
@@ -471,7 +471,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
                         CubeMove::Step => {}
                     }
                 }
-                let change = update_voxel(voxels, index, saturation, rule, self.tables, stats);
+                let change = update_voxel(cells, index, saturation, rule, self.tables, stats);
                 changed += u64::from(change.changed());
                 state_bricks |= u64::from(change.state_changed()) << brick;
                 visits -= 1;

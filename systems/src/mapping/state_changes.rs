@@ -134,7 +134,7 @@ mod tests {
         assert!(world.resource::<Seen>().0.is_empty());
         // A write that keeps states (the map update's path) marks `a` changed only.
         let mut chunk = world.get_mut::<VoxelChunk>(a).unwrap();
-        chunk.voxels_and_saturation_mut().0[0].log_odds = -500;
+        chunk.voxels_for_update().0.voxel_mut(0).log_odds = -500;
         schedule.run(&mut world);
         assert!(world.resource::<Seen>().0.is_empty());
         // A state change reported as such.

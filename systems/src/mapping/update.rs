@@ -1,7 +1,7 @@
 //! The log-odds update of one voxel by one scan (common.md §1, OctoMap semantics).
 
 use uavex_components::map::{
-    BrickSaturation, CHUNK_VOXELS, StatSums, StatTables, UNKNOWN_LOG_ODDS, Voxel, brick_of,
+    BrickSaturation, ChunkCells, StatSums, StatTables, UNKNOWN_LOG_ODDS, brick_of,
 };
 
 /// How one scan changes the voxels it updates with one kind of measurement (hit or miss).
@@ -39,21 +39,22 @@ impl VoxelChange {
     }
 }
 
-/// Applies `rule` to voxel `index` of a chunk's `voxels` unless this scan already updated it
+/// Applies `rule` to voxel `index` of a chunk's `cells` unless this scan already updated it
 /// (or it is saturated and `rule` a miss, which changes nothing):
 /// stamps it, adds the increment to its log-odds (an unknown voxel starts from l = 0, p = 0.5),
-/// clamps, and keeps `stats` in step (old value out, new value in), and `saturation`, which
-/// voxels are at the lower bound ([`BrickSaturation`]).
+/// clamps, and keeps in step `stats` (old value out, new value in), `saturation`, which voxels
+/// are at the lower bound ([`BrickSaturation`]), and the cells' states by row
+/// ([`uavex_components::map::ChunkRows`]).
 #[inline(always)]
 pub fn update_voxel(
-    voxels: &mut [Voxel; CHUNK_VOXELS],
+    cells: &mut ChunkCells,
     index: usize,
     saturation: &mut BrickSaturation,
     rule: UpdateRule,
     tables: &StatTables,
     stats: &mut StatSums,
 ) -> VoxelChange {
-    let voxel = &mut voxels[index % CHUNK_VOXELS];
+    let voxel = cells.voxel_mut(index);
     // A saturated voxel is left as it is, unstamped, by a non-positive increment (a miss): it
     // cannot change, and any later visit of this scan finds it saturated again. (A brick
     // partly outside the frustum never fills, so a camera at rest walks many such voxels.)
@@ -86,6 +87,7 @@ pub fn update_voxel(
     if known && (old < 0) == (new < 0) {
         VoxelChange::LogOdds
     } else {
+        cells.set_known(index, new >= 0);
         VoxelChange::State
     }
 }
@@ -93,7 +95,7 @@ pub fn update_voxel(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use uavex_components::map::VoxelChunk;
+    use uavex_components::map::{Voxel, VoxelChunk};
 
     const TABLES_MIN: i16 = -1992;
     const TABLES_MAX: i16 = 3476;
@@ -126,9 +128,9 @@ mod tests {
         }
 
         fn change(&mut self, rule: UpdateRule) -> VoxelChange {
-            let (voxels, saturation) = self.chunk.voxels_and_saturation_mut();
+            let (cells, saturation) = self.chunk.voxels_for_update();
             update_voxel(
-                voxels,
+                cells,
                 INDEX,
                 saturation,
                 rule,
@@ -238,5 +240,47 @@ mod tests {
         let mut q = Probe::new(-200, 300);
         assert!(q.update(UpdateRule { delta: -847, ..r }));
         assert_eq!((q.voxel().log_odds, q.saturated()), (-200, 1));
+    }
+
+    /// The row states the update keeps are those of the voxels, after every update of random
+    /// scans of hits and misses over a few rows (states become known and cross l = 0 both
+    /// ways), and after a hand write through `voxels_mut` once the map update writes again.
+    #[test]
+    fn row_states_follow_every_update() {
+        use rand::{Rng, SeedableRng};
+        use uavex_components::map::ChunkRows;
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+        let tables = StatTables::new(TABLES_MIN, TABLES_MAX);
+        let mut stats = StatSums::default();
+        let mut chunk = VoxelChunk::new();
+        let rows_of =
+            |chunk: &VoxelChunk| -> Vec<_> { (0..256).map(|row| chunk.row_states(row)).collect() };
+        let expected = |chunk: &VoxelChunk| -> Vec<_> {
+            let rows = ChunkRows::of(chunk.voxels());
+            (0..256).map(|row| rows.get(row)).collect()
+        };
+        let mut state_changes = 0;
+        for stamp in 1..=60u16 {
+            let rule = rule(stamp, if rng.random_bool(0.5) { 847 } else { -405 });
+            for _ in 0..40 {
+                // Rows 0..4 only, so that voxels see many scans.
+                let index = rng.random_range(0..64);
+                let (cells, saturation) = chunk.voxels_for_update();
+                let change = update_voxel(cells, index, saturation, rule, &tables, &mut stats);
+                state_changes += usize::from(change.state_changed());
+                assert_eq!(rows_of(&chunk), expected(&chunk), "scan {stamp}");
+            }
+        }
+        assert!(
+            state_changes > 64,
+            "states crossed l = 0: {state_changes} changes"
+        );
+        chunk.voxels_mut()[5].log_odds = UNKNOWN_LOG_ODDS;
+        chunk.voxels_mut()[300].log_odds = 10;
+        assert_eq!(rows_of(&chunk), expected(&chunk));
+        let (cells, saturation) = chunk.voxels_for_update();
+        update_voxel(cells, 6, saturation, rule(61, 847), &tables, &mut stats);
+        assert_eq!(rows_of(&chunk), expected(&chunk));
+        assert_eq!(chunk.row_states(0).unknown & 0b110_0000, 1 << 5);
     }
 }

@@ -31,7 +31,7 @@
 use super::lattice::Lattice;
 use crate::mapping::{OccupancyMap, StateChange};
 use glam::{DVec3, IVec3};
-use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, Voxel, floor_to_key};
+use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, floor_to_key};
 
 /// Largest inflation, in voxels: a chunk plus its halo and one voxel more must fit a 64-bit
 /// row (16 + 2 x (23 + 1)). Larger radii are clamped (2.3 m at 0.1 m, far beyond any UAV).
@@ -349,8 +349,7 @@ impl TraversableGrid {
                     continue;
                 }
                 let row = (ly + EDGE * lz) as usize;
-                let bits = chunk.row_bits(row, Voxel::is_free);
-                rows[row] = bits & x_mask;
+                rows[row] = chunk.row_states(row).free() & x_mask;
             }
         }
         rows

@@ -85,7 +85,10 @@ fn time_sweep(plan: &Plan, scratch: &Path, jobs: usize) -> f64 {
 /// Times `rounds` paired rounds of `plan` and prints each round's times and the median scaling.
 fn paired_rounds(name: &str, plan: &Plan, scratch: &Path, rounds: usize) {
     let runs = plan.run_count() as f64;
-    println!("{name}: {} runs a sweep, {rounds} paired rounds", plan.run_count());
+    println!(
+        "{name}: {} runs a sweep, {rounds} paired rounds",
+        plan.run_count()
+    );
     // A first sweep each way warms the page cache and the allocator; not counted.
     time_sweep(plan, scratch, 1);
     time_sweep(plan, scratch, 2);

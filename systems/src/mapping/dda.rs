@@ -264,22 +264,29 @@ impl VoxelWalk {
     /// The axis is the one with the earliest boundary; ties go to x, then y, then z (the map
     /// update's inner loop decides the same way). Only that axis' state changes: an axis with
     /// no step left already has the boundary time [`T_RETIRED`] (set when its count ran out).
+    ///
+    /// Every axis computes its would-be update and keeps it only if chosen (selects, not
+    /// branches: which axis is as good as random). Indexing the state by the chosen axis
+    /// instead kept the walk in memory, and each step waited for the last one's store: lines
+    /// of sight ([`all_keys`]) took about 2.5 times as long (perf of replayed decisions).
     #[inline(always)]
     pub fn advance(&mut self) {
         let t = self.t_max;
-        // Which axis is as good as random: chosen arithmetically, not by branches (which
-        // would be mispredicted every other step).
         let x = (t[0] <= t[1]) & (t[0] <= t[2]);
         let y = !x & (t[1] <= t[2]);
-        let axis = usize::from(!x) + usize::from(!x & !y);
-        let remaining = self.remaining[axis].saturating_sub(1);
-        self.remaining[axis] = remaining;
-        self.t_max[axis] = if remaining == 0 {
-            T_RETIRED
-        } else {
-            t[axis].saturating_add(self.t_delta[axis])
-        };
-        self.key[axis] += self.step[axis];
+        let chosen = [x, y, !x & !y];
+        for axis in 0..3 {
+            let remaining = self.remaining[axis].saturating_sub(1);
+            let t_next = if remaining == 0 {
+                T_RETIRED
+            } else {
+                t[axis].saturating_add(self.t_delta[axis])
+            };
+            let c = chosen[axis];
+            self.remaining[axis] = if c { remaining } else { self.remaining[axis] };
+            self.t_max[axis] = if c { t_next } else { t[axis] };
+            self.key[axis] += self.step[axis] * i32::from(c);
+        }
     }
 }
 

@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# Makes pgo/uavex.profdata, the profile-guided optimization data every optimized build uses
+# (scripts/rustc-pgo): builds uavex instrumented, runs the training workload, merges the counts.
+#
+# Needs llvm-profdata of LLVM 19 or later (Debian: `apt-get install llvm-19`; LLVM 19 reads the
+# raw profiles of rustc's LLVM 22, and rustc reads its merged ones). About 8 minutes on the
+# project's 2-core machine. Afterwards `cargo clean`: cargo does not see the profile change.
+#
+# The workload: pgo/training.toml (the EAAE scenes x strategies, seeds 6 and 7, which no
+# benchmark uses), then one run of every other shipped scenario, so that no system is left out
+# of the profile (code never run in training would be laid out as cold).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+profdata=${LLVM_PROFDATA:-$(command -v llvm-profdata-19 || command -v llvm-profdata)}
+work=target/pgo-train
+rm -rf "$work/raw" "$work/runs"
+mkdir -p "$work"
+UAVEX_PGO=off RUSTFLAGS="-Cprofile-generate=$PWD/$work/raw" \
+    cargo build --release --locked --target-dir "$work/build"
+uavex=$work/build/release/uavex
+# The build's own instrumented programs (build scripts, procedural macros) wrote profiles too.
+rm -rf "$work/raw"
+"$uavex" sweep pgo/training.toml --out "$work/runs/sweep" --jobs 2
+for scenario in pillars_scripted pillars_waypoints coverage_field eaae_closed_room \
+    examples/lidar examples/all_obstacles; do
+    "$uavex" run "scenarios/$scenario.toml" --out "$work/runs/$scenario" > /dev/null
+done
+"$profdata" merge --sparse -o pgo/uavex.profdata "$work"/raw/*.profraw
+ls -l pgo/uavex.profdata

@@ -6,12 +6,18 @@
 # raw profiles of rustc's LLVM 22, and rustc reads its merged ones). About 8 minutes on the
 # project's 2-core machine. Afterwards `cargo clean`: cargo does not see the profile change.
 #
-# The workload: pgo/training.toml (the EAAE scenes x strategies, seeds 6 and 7, which no
-# benchmark uses), then one run of every other shipped scenario, so that no system is left out
-# of the profile (code never run in training would be laid out as cold).
+# The workload: pgo/training.toml (the EAAE scenes x strategies, EAAE also with every cluster
+# evaluated, on seed 6, which no benchmark uses), then one run of every other shipped scenario,
+# so that no system is left out of the profile (code never run in training is laid out as
+# cold). Two runs of the script give profiles of the same functions, 99.9 % alike in edge counts
+# (the sweep's two jobs interleave differently).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-profdata=${LLVM_PROFDATA:-$(command -v llvm-profdata-19 || command -v llvm-profdata)}
+profdata=${LLVM_PROFDATA:-$(command -v llvm-profdata-19 || command -v llvm-profdata || true)}
+if [ -z "$profdata" ]; then
+    echo "pgo-train: no llvm-profdata (19 or later) found; apt-get install llvm-19, or set LLVM_PROFDATA" >&2
+    exit 2
+fi
 work=target/pgo-train
 rm -rf "$work/raw" "$work/runs"
 mkdir -p "$work"

@@ -43,30 +43,80 @@ pub fn divisive_two_means(points: &[Vec3], r_max_bound: f32, rng: &mut impl Rng)
     if points.is_empty() {
         return out;
     }
-    // Each pending cluster carries its member indices and a contiguous copy of their points,
-    // so that the passes over a cluster read memory in order.
-    let mut stack = vec![(
-        (0..points.len()).collect::<Vec<usize>>(),
-        Coordinates::of(points),
-    )];
-    let mut side = Vec::new();
-    while let Some((members, pts)) = stack.pop() {
-        let (total, centroid, r_max) = sum_mean_and_radius(&pts);
-        if members.len() == 1 || r_max <= bound {
+    // The members and a copy of their points, coordinate by coordinate, are permuted in place
+    // so that every pending cluster is one contiguous range of both: the passes over a cluster
+    // read memory in order, and a split moves its points within their range (a stable
+    // partition) instead of copying them into new buffers.
+    let mut members: Vec<usize> = (0..points.len()).collect();
+    let mut pts = Coordinates::of(points);
+    let mut scratch = Scratch::default();
+    let mut stack = vec![0..points.len()];
+    while let Some(range) = stack.pop() {
+        let view = pts.view(range.clone());
+        let (total, centroid, r_max) = sum_mean_and_radius(view);
+        if range.len() == 1 || r_max <= bound {
             out.push(Cluster {
                 centroid,
-                members,
+                members: members[range].to_vec(),
                 r_max,
             });
             continue;
         }
-        split(&pts, total, rng, &mut side);
+        split(view, total, rng, &mut scratch);
         // Depth first, the first half before the second.
-        let [first, second] = pts.partition(&members, &side);
-        stack.push(second);
-        stack.push(first);
+        let middle =
+            range.start + scratch.partition(&mut members[range.clone()], &mut pts, range.clone());
+        stack.push(middle..range.end);
+        stack.push(range.start..middle);
     }
     out
+}
+
+/// The buffers the splits reuse: the sides of a Lloyd step (the last and the next), and the
+/// second side's values during a partition.
+#[derive(Debug, Default)]
+struct Scratch {
+    side: Vec<bool>,
+    next: Vec<bool>,
+    members: Vec<usize>,
+    values: Vec<f32>,
+}
+
+impl Scratch {
+    /// Reorders `members` and the points of `range` (one cluster) so that those with `side`
+    /// false come first, then those with `side` true, each in their order: how many are
+    /// false.
+    fn partition(
+        &mut self,
+        members: &mut [usize],
+        pts: &mut Coordinates,
+        range: std::ops::Range<usize>,
+    ) -> usize {
+        let first = stable_partition(members, &self.side, &mut self.members);
+        for values in [&mut pts.x, &mut pts.y, &mut pts.z] {
+            stable_partition(&mut values[range.clone()], &self.side, &mut self.values);
+        }
+        first
+    }
+}
+
+/// Moves the `values` with `side` false to the front and those with `side` true after them,
+/// each in order (`second` holds the latter meanwhile): how many are false.
+fn stable_partition<T: Copy>(values: &mut [T], side: &[bool], second: &mut Vec<T>) -> usize {
+    second.clear();
+    let mut first = 0;
+    for (j, &s) in side.iter().enumerate() {
+        let value = values[j];
+        if s {
+            second.push(value);
+        } else {
+            // `first <= j`: the value it overwrites was moved already.
+            values[first] = value;
+            first += 1;
+        }
+    }
+    values[first..].copy_from_slice(second);
+    first
 }
 
 /// Points stored coordinate by coordinate (a structure of arrays): the passes over a cluster
@@ -79,62 +129,42 @@ struct Coordinates {
     z: Vec<f32>,
 }
 
-/// Points per step of the passes over [`Coordinates`]: one 128-bit vector of `f32`.
+/// The points of one cluster: a range of [`Coordinates`].
+#[derive(Debug, Clone, Copy)]
+struct Points<'a> {
+    x: &'a [f32],
+    y: &'a [f32],
+    z: &'a [f32],
+}
+
+/// Points per step of the passes over [`Points`]: one 128-bit vector of `f32`.
 const LANES: usize = 4;
 
 impl Coordinates {
     fn of(points: &[Vec3]) -> Self {
-        let mut c = Self::with_capacity(points.len());
-        points.iter().for_each(|&p| c.push(p));
-        c
-    }
-
-    fn with_capacity(n: usize) -> Self {
         Self {
-            x: Vec::with_capacity(n),
-            y: Vec::with_capacity(n),
-            z: Vec::with_capacity(n),
+            x: points.iter().map(|p| p.x).collect(),
+            y: points.iter().map(|p| p.y).collect(),
+            z: points.iter().map(|p| p.z).collect(),
         }
     }
 
-    /// The members and points with `side` false, then those with `side` true, each in order.
-    fn partition(&self, members: &[usize], side: &[bool]) -> [(Vec<usize>, Self); 2] {
-        let n1 = side.iter().filter(|&&s| s).count();
-        let half = |n: usize| {
-            let zeros = || vec![0.0; n];
-            (
-                vec![0; n],
-                Self {
-                    x: zeros(),
-                    y: zeros(),
-                    z: zeros(),
-                },
-            )
-        };
-        let mut halves = [half(self.len() - n1), half(n1)];
-        let mut next = [0; 2];
-        for (j, (&m, &s)) in members.iter().zip(side).enumerate() {
-            let (k, (members, points)) = (&mut next[usize::from(s)], &mut halves[usize::from(s)]);
-            members[*k] = m;
-            points.x[*k] = self.x[j];
-            points.y[*k] = self.y[j];
-            points.z[*k] = self.z[j];
-            *k += 1;
+    /// The points of `range`.
+    fn view(&self, range: std::ops::Range<usize>) -> Points<'_> {
+        Points {
+            x: &self.x[range.clone()],
+            y: &self.y[range.clone()],
+            z: &self.z[range],
         }
-        halves
     }
+}
 
-    fn push(&mut self, p: Vec3) {
-        self.x.push(p.x);
-        self.y.push(p.y);
-        self.z.push(p.z);
-    }
-
-    fn len(&self) -> usize {
+impl Points<'_> {
+    fn len(self) -> usize {
         self.x.len()
     }
 
-    fn point(&self, j: usize) -> Vec3 {
+    fn point(self, j: usize) -> Vec3 {
         Vec3::new(self.x[j], self.y[j], self.z[j])
     }
 
@@ -147,7 +177,7 @@ impl Coordinates {
     /// (voxel centres are half a voxel, 0.05 m, or more from a grid plane); larger or finer
     /// ones may round, the same way every run. (Independent partial sums let the additions
     /// overlap instead of waiting for each other.)
-    fn sum(&self) -> DVec3 {
+    fn sum(self) -> DVec3 {
         let coordinate = |values: &[f32]| {
             let mut lanes = [0.0f64; LANES];
             let whole = values.len() / LANES * LANES;
@@ -170,7 +200,7 @@ impl Coordinates {
 
     /// The sum of the points `j` with `after[j]` minus that of those with `before[j]`: the
     /// points that changed side only, found eight sides at a time.
-    fn change_of_sum(&self, before: &[bool], after: &[bool]) -> DVec3 {
+    fn change_of_sum(self, before: &[bool], after: &[bool]) -> DVec3 {
         const STRIDE: usize = 8;
         let mut change = DVec3::ZERO;
         // Eight sides as one word (`==` on the slices would call `memcmp`).
@@ -201,7 +231,7 @@ impl Coordinates {
     /// per lane.
     #[inline(always)]
     fn fold_squared_distances(
-        &self,
+        self,
         from: Vec3,
         start: (f32, usize),
         keep: impl Fn(f32, f32) -> bool,
@@ -234,12 +264,13 @@ impl Coordinates {
 /// Mean of the members and their largest distance to it (the stop rule's `r_max`).
 pub fn centroid_and_radius(points: &[Vec3], members: &[usize]) -> (Vec3, f32) {
     let pts: Vec<Vec3> = members.iter().map(|&m| points[m]).collect();
-    let (_, centroid, r_max) = sum_mean_and_radius(&Coordinates::of(&pts));
+    let pts = Coordinates::of(&pts);
+    let (_, centroid, r_max) = sum_mean_and_radius(pts.view(0..members.len()));
     (centroid, r_max)
 }
 
 /// The sum of the points (f64), their mean and their largest distance to it.
-fn sum_mean_and_radius(pts: &Coordinates) -> (DVec3, Vec3, f32) {
+fn sum_mean_and_radius(pts: Points<'_>) -> (DVec3, Vec3, f32) {
     let sum = pts.sum();
     let centroid = (sum / pts.len().max(1) as f64).as_vec3();
     // The largest squared distance, NaN if any is (a NaN wins whatever comes after it).
@@ -252,9 +283,11 @@ fn sum_mean_and_radius(pts: &Coordinates) -> (DVec3, Vec3, f32) {
 }
 
 /// Splits `pts` (at least two, whose sum is `total`) in two non-empty sides with 2-means;
-/// `side[j]` tells point `j`'s side. Each Lloyd step assigns a point to the nearer centre, tested as the side of the
-/// bisecting plane (`p . (c1 - c0) > (|c1|^2 - |c0|^2) / 2`, one dot product per point).
-fn split(pts: &Coordinates, total: DVec3, rng: &mut impl Rng, side: &mut Vec<bool>) {
+/// `scratch.side[j]` tells point `j`'s side. Each Lloyd step assigns a point to the nearer
+/// centre, tested as the side of the bisecting plane (`p . (c1 - c0) > (|c1|^2 - |c0|^2) / 2`,
+/// one dot product per point).
+fn split(pts: Points<'_>, total: DVec3, rng: &mut impl Rng, scratch: &mut Scratch) {
+    let Scratch { side, next, .. } = scratch;
     side.clear();
     side.resize(pts.len(), false);
     let Some(mut centres) = seeds(pts, rng) else {
@@ -262,7 +295,8 @@ fn split(pts: &Coordinates, total: DVec3, rng: &mut impl Rng, side: &mut Vec<boo
         return;
     };
     let mut valid = false;
-    let mut next = vec![false; pts.len()];
+    next.clear();
+    next.resize(pts.len(), false);
     // The sum of the points on the second side (none yet).
     let mut sum1 = DVec3::ZERO;
     for _ in 0..LLOYD_ITERATIONS {
@@ -273,9 +307,9 @@ fn split(pts: &Coordinates, total: DVec3, rng: &mut impl Rng, side: &mut Vec<boo
         for ((((n, &old), &x), &y), &z) in next
             .iter_mut()
             .zip(side.iter())
-            .zip(&pts.x)
-            .zip(&pts.y)
-            .zip(&pts.z)
+            .zip(pts.x)
+            .zip(pts.y)
+            .zip(pts.z)
         {
             let s = x * w.x + y * w.y + z * w.z > t;
             changed |= s != old;
@@ -288,9 +322,9 @@ fn split(pts: &Coordinates, total: DVec3, rng: &mut impl Rng, side: &mut Vec<boo
         }
         // The second side's sum: the last one's, plus the points that joined it, minus those
         // that left it (after the first steps, few). Exact, as every sum here (see
-        // [`Coordinates::sum`]): the sum over the side, bit for bit.
-        sum1 += pts.change_of_sum(side, &next);
-        std::mem::swap(side, &mut next);
+        // [`Points::sum`]): the sum over the side, bit for bit.
+        sum1 += pts.change_of_sum(side, next);
+        std::mem::swap(side, next);
         if valid && !changed {
             break;
         }
@@ -314,7 +348,7 @@ fn split(pts: &Coordinates, total: DVec3, rng: &mut impl Rng, side: &mut Vec<boo
 /// cut the bulk in halves and drag the sliver along, splitting a compact frontier patch into
 /// many clusters. Seeding on the diameter separates the far part first. `None` when all
 /// members coincide (or distances are not finite).
-fn seeds(pts: &Coordinates, rng: &mut impl Rng) -> Option<[Vec3; 2]> {
+fn seeds(pts: Points<'_>, rng: &mut impl Rng) -> Option<[Vec3; 2]> {
     let r = pts.point(rng.random_range(0..pts.len()));
     let farthest = |from: Vec3| {
         // Per lane the first of its farthest members; of the lanes', the farthest and then
@@ -340,7 +374,7 @@ fn seeds(pts: &Coordinates, rng: &mut impl Rng) -> Option<[Vec3; 2]> {
 
 /// Fallback split (degenerate inputs only): the lexicographically smaller half of the members
 /// against the rest. Both sides are non-empty, so the recursion still ends.
-fn halves(pts: &Coordinates, side: &mut [bool]) {
+fn halves(pts: Points<'_>, side: &mut [bool]) {
     let mut order: Vec<usize> = (0..pts.len()).collect();
     order.sort_by(|&i, &j| {
         let (p, q) = (pts.point(i), pts.point(j));

@@ -11,7 +11,9 @@
 # every function of the workspace differently (the benchmarks' dev-dependencies change the
 # features of shared dependencies, hence every crate's metadata hash): a profile of one build
 # leaves the other unoptimized, silently. `cargo bench --no-run` builds `uavex` too, with the
-# benchmarks' names; the workload runs once with each program, into one profile.
+# benchmarks' names; the workload runs once with each program, into one profile. The names
+# also change with Cargo.lock, the rustc version and dependencies' features: remake the profile
+# after any of these.
 #
 # The workload: pgo/training.toml (the EAAE scenes x strategies, EAAE also with every cluster
 # evaluated, on seed 6, which no benchmark uses), then one run of every other shipped scenario

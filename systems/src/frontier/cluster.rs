@@ -50,6 +50,8 @@ pub fn divisive_two_means(points: &[Vec3], r_max_bound: f32, rng: &mut impl Rng)
     let mut members: Vec<usize> = (0..points.len()).collect();
     let mut pts = Coordinates::of(points);
     let mut scratch = Scratch::default();
+    // The pending clusters, as ranges: the first is all of them.
+    #[allow(clippy::single_range_in_vec_init)]
     let mut stack = vec![0..points.len()];
     while let Some(range) = stack.pop() {
         let view = pts.view(range.clone());
@@ -191,11 +193,7 @@ impl Points<'_> {
             }
             lanes.iter().fold(0.0, |s, l| s + l)
         };
-        DVec3::new(
-            coordinate(&self.x),
-            coordinate(&self.y),
-            coordinate(&self.z),
-        )
+        DVec3::new(coordinate(self.x), coordinate(self.y), coordinate(self.z))
     }
 
     /// The sum of the points `j` with `after[j]` minus that of those with `before[j]`: the

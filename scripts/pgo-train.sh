@@ -13,7 +13,7 @@
 # leaves the other unoptimized, silently. `cargo bench --no-run` builds `uavex` too, with the
 # benchmarks' names; the workload runs once with each program, into one profile. The names
 # also change with Cargo.lock, the rustc version and dependencies' features: remake the profile
-# after any of these.
+# after any of these (scripts/pgo-check.sh tells whether it still reaches both builds).
 #
 # The workload: pgo/training.toml (the EAAE scenes x strategies, EAAE also with every cluster
 # evaluated, on seed 6, which no benchmark uses), then one run of every other shipped scenario

@@ -11,11 +11,7 @@
 # Needs llvm-profdata 19 or later, as scripts/pgo-train.sh. Exit status 1 if a build is missed.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-profdata=${LLVM_PROFDATA:-$(command -v llvm-profdata-19 || command -v llvm-profdata || true)}
-if [ -z "$profdata" ]; then
-    echo "pgo-check: no llvm-profdata (19 or later) found; apt-get install llvm-19, or set LLVM_PROFDATA" >&2
-    exit 2
-fi
+. scripts/pgo-profdata.sh
 hot='_ZN13uavex_systems7mapping9integrate14integrate_scan17h[0-9a-f]*E'
 trained=$("$profdata" show --all-functions pgo/uavex.profdata | grep -o "$hot" | sort -u)
 status=0

@@ -23,11 +23,7 @@
 # (the sweep's two jobs interleave differently).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-profdata=${LLVM_PROFDATA:-$(command -v llvm-profdata-19 || command -v llvm-profdata || true)}
-if [ -z "$profdata" ]; then
-    echo "pgo-train: no llvm-profdata (19 or later) found; apt-get install llvm-19, or set LLVM_PROFDATA" >&2
-    exit 2
-fi
+. scripts/pgo-profdata.sh
 work=target/pgo-train
 rm -rf "$work/runs" "$work/bin"
 mkdir -p "$work/bin"

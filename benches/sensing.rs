@@ -136,44 +136,24 @@ fn sense_and_map(c: &mut Criterion) {
         let mut scan = Scan::default();
         let mut scratch = SweepScratch::default();
         let mut id = ScanId::after(None);
+        // One frame of the camera facing a pillar into `scan`.
+        let frame = |scratch: &mut SweepScratch, scan: &mut Scan| {
+            sweep(&pattern, facing_pillar(), &world, None, scratch, scan, 0.0);
+        };
         // Warm-up: the chunks this frame touches exist, buffers have their size.
-        sweep(
-            &pattern,
-            facing_pillar(),
-            &world,
-            None,
-            &mut scratch,
-            &mut scan,
-            0.0,
-        );
+        frame(&mut scratch, &mut scan);
         let rays = ScanRays::of(&scan);
         integrate_scan(&map, id, rays, increments, &mut store, &mut totals).unwrap();
         group.throughput(Throughput::Elements(pattern.directions.len() as u64));
         group.bench_function(BenchmarkId::new("sweep_only", name), |b| {
             b.iter(|| {
-                sweep(
-                    &pattern,
-                    facing_pillar(),
-                    &world,
-                    None,
-                    &mut scratch,
-                    &mut scan,
-                    0.0,
-                );
+                frame(&mut scratch, &mut scan);
                 black_box(scan.endpoints.len())
             })
         });
         group.bench_function(BenchmarkId::new("thesis_camera_frame", name), |b| {
             b.iter(|| {
-                sweep(
-                    &pattern,
-                    facing_pillar(),
-                    &world,
-                    None,
-                    &mut scratch,
-                    &mut scan,
-                    0.0,
-                );
+                frame(&mut scratch, &mut scan);
                 id = ScanId::after(Some(id));
                 let rays = ScanRays::of(&scan);
                 black_box(

@@ -8,40 +8,7 @@ use uavex::engine::sweep::{Plan, SweepOptions, SweepReport, run_sweep};
 
 /// A 6 x 6 x 2 m room with a seeded pillar field, one UAV on a scripted leg with a noisy
 /// camera: every source of randomness a run has, in a run of a fraction of a second.
-pub const ROOM: &str = r#"
-name = "room"
-seed = 0
-time_limit_s = 3.0
-physics_rate_hz = 100.0
-
-[map]
-resolution = 0.2
-
-[world.bounds]
-min = [-3.0, -3.0, 0.0]
-max = [3.0, 3.0, 2.0]
-
-[[world.obstacle]]
-kind = "pillars"
-region_min = [-2.5, -2.5]
-region_max = [2.5, 2.5]
-density = 0.1
-radius_min = 0.1
-radius_max = 0.3
-height = 2.0
-
-[[uav]]
-name = "a"
-start = { position = [0.0, 0.0, 1.0] }
-behaviour = { kind = "scripted", speed = 1.0, waypoints = [[2.0, 0.0, 1.0], [2.0, 2.0, 1.0]] }
-[[uav.sensor]]
-kind = "depth_camera"
-ray_grid = [32, 24]
-quality = { range_noise_std = 0.02 }
-
-[outputs]
-export_map = false
-"#;
+pub const ROOM: &str = include_str!("fixtures/sweep_room.toml");
 
 /// Writes `room.toml` and a plan with `plan_body` followed by a `[[scenario]]` for the room
 /// into `dir`; returns the loaded plan.

@@ -104,34 +104,9 @@ uavex="${repo}/target/release/uavex"
 
 work=$(mktemp -d /tmp/uavex-slurm.XXXXXX)
 echo "== a sweep of 8 short runs in ${work}"
-cat > "${work}/room.toml" <<'TOML'
-name = "room"
-time_limit_s = 4.0
-physics_rate_hz = 100.0
-[map]
-resolution = 0.2
-[world.bounds]
-min = [-3.0, -3.0, 0.0]
-max = [3.0, 3.0, 2.0]
-[[world.obstacle]]
-kind = "pillars"
-region_min = [-2.5, -2.5]
-region_max = [2.5, 2.5]
-density = 0.1
-radius_min = 0.1
-radius_max = 0.3
-height = 2.0
-[[uav]]
-name = "a"
-start = { position = [0.0, 0.0, 1.0] }
-behaviour = { kind = "scripted", speed = 1.0, waypoints = [[2.0, 0.0, 1.0], [2.0, 2.0, 1.0]] }
-[[uav.sensor]]
-kind = "depth_camera"
-ray_grid = [32, 24]
-quality = { range_noise_std = 0.02 }
-[outputs]
-export_map = false
-TOML
+# The sweep tests' room (tests/sweep_common.rs): runs of a fraction of a second with every
+# source of randomness a run has.
+cp "${repo}/tests/fixtures/sweep_room.toml" "${work}/room.toml"
 cat > "${work}/plan.toml" <<'TOML'
 name = "slurm_local_test"
 seeds = 4

@@ -310,10 +310,11 @@ fn too_large(qlo: DVec3, qhi: DVec3) -> MapConfigError {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
-    fn config(min: f64, max: f64, res: f64) -> MapConfig {
+    /// The map of the cube `min..max` (m, on every axis) at resolution `res` (m).
+    pub(in crate::map) fn config(min: f64, max: f64, res: f64) -> MapConfig {
         MapConfig::new(&MapSettings {
             resolution: res,
             bounds_min: DVec3::splat(min),

@@ -54,19 +54,8 @@ impl ChunkGrid {
 
 #[cfg(test)]
 mod tests {
-    use super::super::config::{MapConfig, MapSettings};
+    use super::super::config::tests::config;
     use super::*;
-    use glam::DVec3;
-
-    fn config(min: f64, max: f64, res: f64) -> MapConfig {
-        MapConfig::new(&MapSettings {
-            resolution: res,
-            bounds_min: DVec3::splat(min),
-            bounds_max: DVec3::splat(max),
-            ..MapSettings::default()
-        })
-        .unwrap()
-    }
 
     #[test]
     fn chunk_grid_flat_round_trips() {

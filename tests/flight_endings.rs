@@ -134,6 +134,48 @@ fn bad_airframe_overrides_are_refused_at_their_line() {
 }
 
 #[test]
+fn planning_limits_beyond_a_multirotor_are_refused_at_their_line() {
+    // 1e30 m/s once made the planner's collision sampling (a step of spacing / max_velocity
+    // over a trajectory whose length the acceleration sets) run forever.
+    let text = room_scenario(
+        r#"{ kind = "waypoints", waypoints = [[2.0, 0.0, 1.5]] }"#,
+        "max_velocity = 1e30",
+    );
+    let errors = refusal(&common::scenario(&text));
+    assert_eq!(errors.len(), 1, "{errors:?}");
+    assert_eq!(errors[0].path, "uav[0].airframe_overrides.max_velocity");
+    assert_eq!(errors[0].line, line_of(&text, "max_velocity = 1e30"));
+    assert!(
+        errors[0]
+            .message
+            .contains("max_velocity must be in [0.1, 100]"),
+        "{}",
+        errors[0]
+    );
+}
+
+#[test]
+fn a_flight_that_diverges_ends_failed_with_the_reason() {
+    // A roll inertia of 1e-30 kg m^2 passes every check on its own, but the attitude dynamics
+    // blow up within steps: the run must say so, not fail later on a sensor origin that is
+    // not finite, nor run on with NaN metrics.
+    let text = room_scenario(
+        r#"{ kind = "waypoints", waypoints = [[2.0, 0.0, 1.5]] }"#,
+        "inertia_xx = 1e-30",
+    );
+    let summary = common::run_quietly(&common::scenario(&text));
+    assert_eq!(summary.outcome, Outcome::Failed, "{}", summary.reason);
+    assert!(
+        summary
+            .reason
+            .starts_with("UAV 'k' became numerically unstable at t = "),
+        "{}",
+        summary.reason
+    );
+    assert!(summary.mission_time_s < 1.0, "{}", summary.mission_time_s);
+}
+
+#[test]
 fn a_tour_into_a_wall_or_too_close_to_it_is_refused_at_its_waypoint() {
     let text = room_scenario(
         r#"{ kind = "waypoints", waypoints = [

@@ -110,6 +110,13 @@ pub struct Airframe {
     pub battery: BatterySpec,
 }
 
+/// Fastest planning speed an airframe may state (m/s): above the fastest multirotors flown. The
+/// planners' collision sampling and time allocation take work in proportion to it.
+pub const MAX_VELOCITY: f64 = 100.0;
+/// Slowest planning speed (m/s) and acceleration (m/s^2) an airframe may state: below it a leg
+/// of a few metres takes minutes, a typo rather than a study.
+pub const MIN_PLANNING_LIMIT: f64 = 0.1;
+
 /// Names of the presets [`Airframe::preset`] knows.
 pub const PRESET_NAMES: [&str; 2] = ["kingfisher", "iris"];
 
@@ -388,7 +395,7 @@ impl Airframe {
                     .into(),
             );
         }
-        let (_, thrust_max) = self.rotor_thrust_range();
+        let (thrust_min, thrust_max) = self.rotor_thrust_range();
         let weight = self.mass * GRAVITY;
         if 4.0 * thrust_max <= weight {
             return Err(format!(
@@ -396,6 +403,36 @@ impl Airframe {
                  thrust_coefficient x rotor_speed_max^2), less than the weight {weight:.2} N \
                  (mass x g)",
                 4.0 * thrust_max
+            ));
+        }
+        if 4.0 * thrust_min >= weight {
+            return Err(format!(
+                "the rotors' idle thrust ({:.3} N: 4 x thrust_coefficient x rotor_speed_min^2) \
+                 is not below the weight {weight:.3} N (mass x g): the airframe can neither \
+                 hover nor descend",
+                4.0 * thrust_min
+            ));
+        }
+        self.validate_planning_limits(thrust_max)
+    }
+
+    /// The planning limits within what a multirotor (and the planner's sampling) can take.
+    fn validate_planning_limits(&self, thrust_max: f64) -> Result<(), String> {
+        let v = self.max_velocity;
+        if !(MIN_PLANNING_LIMIT..=MAX_VELOCITY).contains(&v) {
+            return Err(format!(
+                "max_velocity must be in [{MIN_PLANNING_LIMIT}, {MAX_VELOCITY}] m/s, got {v}"
+            ));
+        }
+        // Thrust must carry the planned acceleration in every direction, straight up included:
+        // |a + g| <= a_max + g <= 4 f_max / m.
+        let climb = 4.0 * thrust_max / self.mass - GRAVITY;
+        let a = self.max_acceleration;
+        if !(MIN_PLANNING_LIMIT..=climb).contains(&a) {
+            return Err(format!(
+                "max_acceleration must be in [{MIN_PLANNING_LIMIT}, {climb:.2}] m/s^2 (the upper \
+                 bound is what the rotors give straight up: 4 x rotor thrust max / mass - g), \
+                 got {a}"
             ));
         }
         Ok(())
@@ -511,11 +548,36 @@ mod tests {
             ("arm_x", 0.0),
             // 8.5 N per rotor cannot lift 4 kg.
             ("mass", 4.0),
+            // Idle thrust 4 x 1.562522e-6 x 150^2 = 0.1406 N lifts more than 0.01 kg (0.098 N).
+            ("mass", 0.01),
+            ("mass", 1e-30),
+            // Planning limits beyond a multirotor's (1e30 m/s made the collision sampling hang).
+            ("max_velocity", 1e30),
+            ("max_velocity", 100.5),
+            ("max_velocity", 0.05),
+            ("max_acceleration", 1e-9),
+            // Straight up the rotors give 4 x 8.5 / 0.752 - 9.81 = 35.40 m/s^2.
+            ("max_acceleration", 35.5),
         ];
         for (name, value) in cases {
             let mut airframe = Airframe::kingfisher();
             let result = airframe.apply_overrides(&BTreeMap::from([(name.to_owned(), value)]));
             assert!(result.is_err(), "{name} = {value} was accepted");
+        }
+    }
+
+    #[test]
+    fn limits_within_the_envelope_are_accepted() {
+        let cases = [
+            ("max_velocity", 100.0),
+            ("max_velocity", 0.1),
+            ("max_acceleration", 35.3),
+            ("mass", 0.015),
+        ];
+        for (name, value) in cases {
+            let mut airframe = Airframe::kingfisher();
+            let result = airframe.apply_overrides(&BTreeMap::from([(name.to_owned(), value)]));
+            assert!(result.is_ok(), "{name} = {value}: {result:?}");
         }
     }
 

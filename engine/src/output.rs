@@ -155,6 +155,16 @@ fn cell(value: Option<f64>) -> String {
     value.map(|v| v.to_string()).unwrap_or_default()
 }
 
+/// `text` as one CSV field (RFC 4180): quoted, with its quotes doubled, when it holds a comma,
+/// a quote or a line break (a UAV named "left,right" once split its rows into 14 fields).
+fn text_cell(text: &str) -> std::borrow::Cow<'_, str> {
+    if text.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", text.replace('"', "\"\"")).into()
+    } else {
+        text.into()
+    }
+}
+
 /// The map time series as CSV, one row per sample.
 pub fn map_series_csv(rows: &[MapRow]) -> String {
     let mut out = String::from(
@@ -196,7 +206,7 @@ pub fn uav_series_csv(rows: &[UavRow]) -> String {
             out,
             "{},{},{},{},{},{},{},{},{},{},{},{},{}",
             r.time_s,
-            r.uav,
+            text_cell(&r.uav),
             r.x,
             r.y,
             r.z,
@@ -272,6 +282,24 @@ mod tests {
                 "0.5,kinematic,1,2,3,0.25,1.5,4,,,,,",
             ]
         );
+    }
+
+    #[test]
+    fn uav_names_with_commas_or_quotes_stay_one_field() {
+        let names = ["left,right", "say \"hi\"", "two\nlines", "plain"];
+        let rows: Vec<UavRow> = names.iter().map(|&n| row(n, None, None)).collect();
+        let text = uav_series_csv(&rows);
+        let mut reader = csv::Reader::from_reader(text.as_bytes());
+        let width = reader.headers().unwrap().len();
+        let read: Vec<String> = reader
+            .records()
+            .map(|record| {
+                let record = record.unwrap();
+                assert_eq!(record.len(), width, "{record:?}");
+                record[1].to_owned()
+            })
+            .collect();
+        assert_eq!(read, names);
     }
 
     #[test]

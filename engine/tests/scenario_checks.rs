@@ -23,7 +23,18 @@ const SEMANTIC: &[(&str, &str, &str, usize, usize, &str)] = &[
         "physics_rate_hz",
         3,
         19,
-        "must be above 0",
+        "must be at least 50 Hz (the motors' 0.033 s lag and the attitude loop diverge at \
+         longer steps; common.md §3 runs at 300 Hz)",
+    ),
+    (
+        // At 1 Hz a waypoint tour flew twice its path; at 1e-6 Hz one step outlasted the run.
+        "time_limit_s = 60.0",
+        "time_limit_s = 60.0\nphysics_rate_hz = 1.0",
+        "physics_rate_hz",
+        3,
+        19,
+        "must be at least 50 Hz (the motors' 0.033 s lag and the attitude loop diverge at \
+         longer steps; common.md §3 runs at 300 Hz)",
     ),
     (
         "max = [10.0, 10.0, 3.0]",

@@ -140,6 +140,45 @@ fn type_errors_name_the_value_and_what_was_expected() {
 }
 
 #[test]
+fn errors_in_an_exploration_behaviour_are_reported_at_their_field() {
+    // These were all reported at `kind` or the behaviour table ("unknown behaviour 'greedy'").
+    let explore = |settings: &str| {
+        with(
+            "kind = \"scripted\"\nspeed = 1.0\nwaypoints = [[5.0, 5.0, 1.0]]",
+            &format!("kind = \"explore\"\n{settings}"),
+        )
+    };
+    assert_only(
+        &explore("strategy = \"greedy\""),
+        "uav[0].behaviour.strategy",
+        19,
+        12,
+        "unknown value 'greedy', expected one of: eaae, classic, nearest",
+    );
+    assert_only(
+        &explore("strategy = \"eaae\"\nevaluate = \"most\""),
+        "uav[0].behaviour.evaluate",
+        20,
+        12,
+        "unknown value 'most', expected one of: needed, all",
+    );
+    assert_only(
+        &explore("strategy = \"eaae\"\ncandidates = \"some\""),
+        "uav[0].behaviour.candidates",
+        20,
+        14,
+        "expected a whole number of clusters, or \"all\"",
+    );
+    assert_only(
+        &explore("strategy = \"eaae\"\nenergy_budget = {}"),
+        "uav[0].behaviour.energy_budget.reserve_j",
+        20,
+        1,
+        "required field is missing",
+    );
+}
+
+#[test]
 fn unknown_kinds_name_what_this_build_knows() {
     assert_only(
         &with("kind = \"scripted\"", "kind = \"eaae\""),
@@ -235,6 +274,16 @@ fn non_finite_numbers_are_refused_where_written() {
         "must be a finite number",
     );
     assert_eq!(d.found.as_deref(), Some("inf"));
+    // Finite in the file but infinite as the 32-bit float the geometry stores (a pillar radius of
+    // 1e39 used to panic while the world was built).
+    let d = assert_only(
+        &with("max = [10.0, 10.0, 3.0]", "max = [10.0, 1e39, 3.0]"),
+        "world.bounds.max[1]",
+        6,
+        14,
+        "must be at most 3.4e38 in magnitude (positions and sizes are 32-bit floats)",
+    );
+    assert_eq!(d.found.as_deref(), Some("1e39"));
 }
 
 #[test]

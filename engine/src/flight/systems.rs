@@ -99,12 +99,26 @@ pub fn step_physics(
     physics.world.step();
     // The lowest-index UAV's crash names the run's ending (query order is storage order).
     let mut first_crash: Option<(usize, String)> = None;
+    let mut first_unstable: Option<(usize, String)> = None;
     for (entity, uav, body, _, mut state, mut energy, ended) in &mut uavs {
         let world = &physics.world;
         *state = QuadState::from(&world.state(body.0));
         energy.meter.clone_from(world.meter(body.0));
         energy.battery = *world.battery(body.0);
         energy.power_w = world.power_w(body.0);
+        if !(state.is_finite() && energy.power_w.is_finite()) && ended.is_none() {
+            // A diverged integration would otherwise surface ticks later, far from its cause
+            // (as a sensor origin that is not finite), or run on with NaN metrics.
+            let reason = format!(
+                "UAV '{}' became numerically unstable at t = {:.3} s (its state is no longer                  finite): the airframe (mass, inertia, torque_coefficient, drag) cannot be                  simulated at this physics_rate_hz",
+                uav.name,
+                world.time_s()
+            );
+            if first_unstable.as_ref().is_none_or(|(i, _)| uav.index < *i) {
+                first_unstable = Some((uav.index, reason));
+            }
+            continue;
+        }
         let UavStatus::Crashed { time_s, position } = world.status(body.0) else {
             continue;
         };
@@ -124,10 +138,12 @@ pub fn step_physics(
             first_crash = Some((uav.index, reason));
         }
     }
-    if let Some((_, reason)) = first_crash
-        && run_end.0.is_none()
-    {
-        run_end.0 = Some((Outcome::Crashed, reason));
+    if run_end.0.is_none() {
+        if let Some((_, reason)) = first_unstable {
+            run_end.0 = Some((Outcome::Failed, reason));
+        } else if let Some((_, reason)) = first_crash {
+            run_end.0 = Some((Outcome::Crashed, reason));
+        }
     }
 }
 

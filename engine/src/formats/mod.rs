@@ -49,6 +49,18 @@ pub enum Problem {
     /// The file could not be opened or read.
     #[error("cannot read the file: {0}")]
     Io(#[from] io::Error),
+    /// The path names a directory, device, FIFO or socket, not a regular file.
+    #[error("not a regular file (a directory, device or pipe)")]
+    NotAFile,
+    /// The file is larger than any world file this reader takes.
+    #[error(
+        "the file has {bytes} bytes, more than the {} this reader takes",
+        MAX_FILE_BYTES
+    )]
+    TooLarge {
+        /// Its size.
+        bytes: u64,
+    },
     /// The file name's extension names no format this reader knows.
     #[error("unsupported file extension {found:?}, expected one of {expected}")]
     UnsupportedExtension {
@@ -151,9 +163,25 @@ pub(crate) fn extension(path: &Path) -> String {
         .unwrap_or_default()
 }
 
-/// Reads a whole file, turning an I/O failure into a [`FormatError`].
+/// Largest world file read (bytes): 4 GB is a scanned building at millimetres, beyond what a
+/// run's geometry can hold in memory twice.
+pub const MAX_FILE_BYTES: u64 = 4 << 30;
+
+/// Reads a whole file, turning an I/O failure into a [`FormatError`]. Only regular files of at
+/// most [`MAX_FILE_BYTES`]: a FIFO would block the load forever, and a link to `/dev/zero`
+/// read until memory ran out.
 pub(crate) fn read_file(path: &Path) -> Result<Vec<u8>, FormatError> {
-    std::fs::read(path).map_err(|e| Fault::problem(Problem::Io(e)).in_file(path))
+    let fault = |problem| Fault::problem(problem).in_file(path);
+    let metadata = std::fs::metadata(path).map_err(|e| fault(Problem::Io(e)))?;
+    if !metadata.is_file() {
+        return Err(fault(Problem::NotAFile));
+    }
+    if metadata.len() > MAX_FILE_BYTES {
+        return Err(fault(Problem::TooLarge {
+            bytes: metadata.len(),
+        }));
+    }
+    std::fs::read(path).map_err(|e| fault(Problem::Io(e)))
 }
 
 /// Splits text into 1-based numbered lines (without `\n` or a trailing `\r`), lossily decoded:
@@ -190,6 +218,22 @@ mod tests {
         );
         let e = Fault::bare("truncated").in_file(Path::new("c.stl"));
         assert_eq!(e.to_string(), "c.stl: truncated");
+    }
+
+    #[test]
+    fn only_regular_files_are_read() {
+        let dir = tempfile::tempdir().unwrap();
+        let error = read_file(dir.path()).unwrap_err();
+        assert!(matches!(error.problem, Problem::NotAFile), "{error}");
+        // A device reads forever (a world file linked to /dev/zero filled the memory).
+        let zero = Path::new("/dev/zero");
+        if zero.exists() {
+            let error = read_file(zero).unwrap_err();
+            assert!(matches!(error.problem, Problem::NotAFile), "{error}");
+        }
+        let file = dir.path().join("a.obj");
+        std::fs::write(&file, "v 0 0 0\n").unwrap();
+        assert_eq!(read_file(&file).unwrap(), b"v 0 0 0\n");
     }
 
     #[test]

@@ -19,7 +19,7 @@ use super::path::FieldPath;
 use super::schema::{BoundsSpec, MapSpec, ObstacleSpec, Scenario, SensorSpec, UavSpec};
 use super::source_map::Anchor;
 
-pub(crate) use numbers::non_finite;
+pub(crate) use numbers::{non_finite, unusable_number, usable};
 
 /// Fewer voxels than this along the smallest side of the bounds is too coarse to map anything.
 pub const MIN_VOXELS_PER_SIDE: f64 = 4.0;
@@ -34,6 +34,13 @@ pub const MAX_PILLARS: f64 = 1e5;
 /// Physics steps per run (time_limit_s x physics_rate_hz): 1e8 steps are 3.9 simulated days at
 /// 300 Hz; more is a typo that would make a run look hung.
 pub const MAX_STEPS: f64 = 1e8;
+/// Slowest physics and control rate (Hz): a step of 0.02 s is already below the kingfisher's
+/// motor time constant (0.033 s) by little; at 1 Hz a waypoint tour flew twice its path and
+/// drew 486 W peaks, at 1e-6 Hz one step outlasted the run.
+pub const MIN_PHYSICS_RATE_HZ: f64 = 50.0;
+/// Farthest a sensor may sit from its UAV's centre (m): a longer boom is a typo (a camera
+/// mounted 100 m away looked at nothing of the world and the run "explored" 0 %).
+pub const MAX_MOUNT_OFFSET_M: f64 = 2.0;
 /// Airframe presets this build knows (common.md §3).
 pub const KNOWN_AIRFRAMES: &[&str] = &["kingfisher", "iris"];
 
@@ -125,7 +132,11 @@ impl<'a> Parts<'a> {
 /// Every semantic finding of `parts`, in the order of the file's sections.
 pub(crate) fn check_parts(parts: &Parts<'_>) -> Vec<Finding> {
     let mut out = Vec::new();
-    let context = world::Context::of(parts.map, parts.bounds);
+    let context = world::Context::of(
+        parts.map,
+        parts.bounds,
+        parts.root.map(|root| root.physics_rate_hz),
+    );
     if let Some(root) = parts.root {
         world::check_run(root, &mut out);
     }
@@ -153,6 +164,7 @@ pub(crate) fn check_parts(parts: &Parts<'_>) -> Vec<Finding> {
         );
     }
     uav::check_names(&parts.uavs, &mut out);
+    uav::check_start_separation(&parts.uavs, &mut out);
     for part in &parts.uavs {
         let path = FieldPath::root().key("uav").index(part.index);
         if let Some(spec) = part.spec {

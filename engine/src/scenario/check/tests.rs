@@ -70,7 +70,19 @@ fn run_settings() {
             "time_limit_s = 60.0",
             "time_limit_s = 60.0\nphysics_rate_hz = -300.0"
         )),
-        finding("physics_rate_hz", "must be above 0", "-300.0")
+        finding(
+            "physics_rate_hz",
+            "must be at least 50 Hz (the motors' 0.033 s lag and the attitude loop diverge at \
+             longer steps; common.md §3 runs at 300 Hz)",
+            "-300.0"
+        )
+    );
+    assert_eq!(
+        findings(&with(
+            "time_limit_s = 60.0",
+            "time_limit_s = 60.0\nphysics_rate_hz = 50.0"
+        )),
+        vec![]
     );
     // 1e6 s at 300 Hz is 3e8 steps; the limit 1e8 allows 333333.33 s.
     let (path, message, _) = one(&with("time_limit_s = 60.0", "time_limit_s = 1e6"));
@@ -221,6 +233,37 @@ fn camera_settings() {
         one(&camera("ray_grid = [64, 0]")),
         finding("uav[0].sensor[0].ray_grid[1]", "must be at least 1", "0")
     );
+    // A camera reaching no farther than its own 0.1 m voxel once ended "complete" at 0 %.
+    assert_eq!(
+        one(&camera("range_min = 0.0\nrange_max = 0.05")),
+        finding(
+            "uav[0].sensor[0].range_max",
+            "must be above map.resolution (0.1 m): the sensor must reach past its own voxel",
+            "0.05"
+        )
+    );
+    // The default physics rate is 300 Hz; a faster camera was capped there silently.
+    assert_eq!(
+        one(&camera("rate_hz = 1e9")),
+        finding(
+            "uav[0].sensor[0].rate_hz",
+            "must be at most physics_rate_hz (300.0): a sensor scans at most once per physics \
+             step",
+            "1000000000.0"
+        )
+    );
+    assert_eq!(
+        one(&camera("mount = { translation = [100.0, 0.0, 0.0] }")),
+        finding(
+            "uav[0].sensor[0].mount.translation",
+            "must be within 2 m of the UAV's centre",
+            "[100.0, 0.0, 0.0]"
+        )
+    );
+    assert_eq!(
+        findings(&camera("mount = { translation = [0.1, 0.0, -0.05] }")),
+        vec![]
+    );
     let (path, _, found) = one(&camera("ray_grid = [10000, 10000]"));
     assert_eq!(path, "uav[0].sensor[0].ray_grid");
     assert_eq!(found.as_deref(), Some("1.000e8 rays"));
@@ -369,6 +412,29 @@ fn uav_set() {
             "\"a\""
         )
     );
+    // Two UAVs flying on the true quadrotor from one start would crash into each other at
+    // t = 0; kinematic (scripted) ones have no body and may share a start.
+    let flying = |position: &str| {
+        let tour = "behaviour = { kind = \"waypoints\", waypoints = [[5.0, 5.0, 1.0]] }";
+        format!(
+            "{}\n[[uav]]\nname = \"b\"\nstart = {{ position = {position} }}\n{tour}\n",
+            BASE.replace(
+                "[uav.behaviour]\nkind = \"scripted\"\nspeed = 1.0\nwaypoints = [[5.0, 5.0, 1.0]]",
+                "[uav.behaviour]\nkind = \"waypoints\"\nwaypoints = [[5.0, 5.0, 1.0]]",
+            )
+        )
+    };
+    let (path, message, found) = one(&flying("[1.0, 1.0, 1.0]"));
+    assert_eq!(
+        (path.as_str(), found.as_deref()),
+        ("uav[1].start.position", Some("[1.0, 1.0, 1.0]"))
+    );
+    assert!(message.starts_with("must be more than 0."), "{message}");
+    assert_eq!(findings(&flying("[3.0, 1.0, 1.0]")), vec![]);
+    let scripted = format!(
+        "{BASE}\n[[uav]]\nname = \"b\"\nstart = {{ position = [1.0, 1.0, 1.0] }}\nbehaviour = {{ kind = \"scripted\", speed = 1.0, waypoints = [[1.0, 2.0, 1.0]] }}\n"
+    );
+    assert_eq!(findings(&scripted), vec![]);
     let none = &BASE[..BASE.find("[[uav]]").unwrap()];
     let (path, message, found) = one(none);
     assert_eq!(path, "uav");
@@ -467,6 +533,31 @@ fn non_finite_numbers_are_reported_once_by_path() {
             "must be a finite number",
             "NaN"
         )
+    );
+}
+
+#[test]
+fn numbers_beyond_32_bit_floats_are_refused_on_the_typed_scenario() {
+    // A sweep may set 1e39 where the file had a sane value: it must not reach the world builder,
+    // where it becomes an infinite `f32` (a pillar radius of 1e39 panicked there).
+    let mut scenario = scenario(&with("speed = 1.0", "speed = 1e39"));
+    scenario.world.bounds.max[0] = -1e300;
+    let found: Vec<(String, Option<String>)> = non_finite(&scenario)
+        .iter()
+        .map(|f| (f.path.to_string(), f.found.clone()))
+        .collect();
+    assert_eq!(
+        found,
+        [
+            (
+                "uav[0].behaviour.speed".to_string(),
+                Some("1e39".to_string())
+            ),
+            (
+                "world.bounds.max[0]".to_string(),
+                Some("-1e300".to_string())
+            ),
+        ]
     );
 }
 

@@ -4,17 +4,18 @@ use std::f64::consts::PI;
 
 use super::world::{Context, check_hit_miss};
 use super::{
-    KNOWN_AIRFRAMES, MAX_RAYS_PER_SCAN, UavPart, angle, at_least_one, inside, non_negative,
-    positive, triple,
+    KNOWN_AIRFRAMES, MAX_MOUNT_OFFSET_M, MAX_RAYS_PER_SCAN, UavPart, angle, at_least_one, inside,
+    non_negative, positive, triple,
 };
 use crate::exploration::CandidateCount;
 use crate::scenario::diagnostic::{Finding, number};
 use crate::scenario::path::FieldPath;
 use crate::scenario::schema::{
-    BehaviourSpec, BoundsSpec, QualitySpec, RayGridSpec, SensorSpec, UavSpec,
+    BehaviourSpec, BoundsSpec, MountSpec, QualitySpec, RayGridSpec, SensorSpec, UavSpec,
 };
 use crate::scenario::source_map::Anchor;
 use crate::scenario::suggest::{closest, plain_list};
+use uavex_components::airframe::Airframe;
 
 /// UAV names identify UAVs in outputs: no two may share one.
 pub(crate) fn check_names(uavs: &[UavPart<'_>], out: &mut Vec<Finding>) {
@@ -32,6 +33,52 @@ pub(crate) fn check_names(uavs: &[UavPart<'_>], out: &mut Vec<Finding>) {
             ));
         } else {
             seen.push((&spec.name, part.index));
+        }
+    }
+}
+
+/// UAVs that fly on the true quadrotor must not start overlapping: their collision boxes would
+/// touch at t = 0 and the run end `crashed` before anything happened. Each airframe counts with
+/// its bounding sphere (its preset's, or with its size overrides when they are valid).
+pub(crate) fn check_start_separation(uavs: &[UavPart<'_>], out: &mut Vec<Finding>) {
+    let flying: Vec<(usize, [f64; 3], f64)> = uavs
+        .iter()
+        .filter_map(|part| {
+            let spec = part.spec?;
+            if matches!(spec.behaviour, BehaviourSpec::Scripted { .. }) {
+                return None;
+            }
+            let preset = Airframe::preset(&spec.airframe).ok()?;
+            let mut airframe = preset.clone();
+            let airframe = match airframe.apply_overrides(&spec.airframe_overrides) {
+                Ok(()) => airframe,
+                Err(_) => preset,
+            };
+            Some((part.index, spec.start.position, airframe.bounding_radius()))
+        })
+        .collect();
+    for (k, &(index, start, radius)) in flying.iter().enumerate() {
+        let distance = |other: [f64; 3]| {
+            let d: f64 = (0..3).map(|a| (start[a] - other[a]).powi(2)).sum();
+            d.sqrt()
+        };
+        if let Some(&(first, _, other)) = flying[..k]
+            .iter()
+            .find(|&&(_, other, r)| distance(other) <= radius + r)
+        {
+            out.push(Finding::must_be(
+                FieldPath::root()
+                    .key("uav")
+                    .index(index)
+                    .key("start")
+                    .key("position"),
+                format!(
+                    "more than {:.2} m from uav[{first}]'s start (the two airframes' bounding \
+                     spheres would overlap at t = 0)",
+                    radius + other
+                ),
+                triple(start),
+            ));
         }
     }
 }
@@ -189,13 +236,14 @@ pub(crate) fn check_sensor(
             rate_hz,
             ray_grid,
             quality,
-            ..
+            mount,
         } => {
             at_least_one(out, path.key("width"), *width);
             at_least_one(out, path.key("height"), *height);
             angle(out, path.key("hfov"), *hfov, PI, true);
-            check_ranges(path, *range_min, *range_max, out);
-            positive(out, path.key("rate_hz"), *rate_hz);
+            check_ranges(path, *range_min, *range_max, context, out);
+            check_rate(path, *rate_hz, context, out);
+            check_mount(path, mount, out);
             check_quality(path, quality, out);
             let rays = match ray_grid {
                 RayGridSpec::Explicit([columns, rows]) => {
@@ -218,7 +266,7 @@ pub(crate) fn check_sensor(
             range_max,
             rate_hz,
             quality,
-            ..
+            mount,
         } => {
             angle(out, path.key("hfov"), *hfov, 2.0 * PI, false);
             at_least_one(out, path.key("beams_h"), *beams_h);
@@ -232,8 +280,9 @@ pub(crate) fn check_sensor(
                     number(*vfov),
                 ));
             }
-            check_ranges(path, *range_min, *range_max, out);
-            positive(out, path.key("rate_hz"), *rate_hz);
+            check_ranges(path, *range_min, *range_max, context, out);
+            check_rate(path, *rate_hz, context, out);
+            check_mount(path, mount, out);
             check_quality(path, quality, out);
             check_ray_count(
                 &path.key("beams_h"),
@@ -244,8 +293,15 @@ pub(crate) fn check_sensor(
     }
 }
 
-/// 0 <= range_min < range_max.
-fn check_ranges(path: &FieldPath, range_min: f64, range_max: f64, out: &mut Vec<Finding>) {
+/// 0 <= range_min < range_max, and range_max beyond one voxel of the map (a shorter sensor
+/// observes no voxel but its own, and the run would end "complete" at 0 % explored).
+fn check_ranges(
+    path: &FieldPath,
+    range_min: f64,
+    range_max: f64,
+    context: &Context,
+    out: &mut Vec<Finding>,
+) {
     non_negative(out, path.key("range_min"), range_min);
     positive(out, path.key("range_max"), range_max);
     if range_min >= 0.0 && range_max > 0.0 && range_min >= range_max {
@@ -253,6 +309,49 @@ fn check_ranges(path: &FieldPath, range_min: f64, range_max: f64, out: &mut Vec<
             path.key("range_min"),
             format!("below range_max ({})", number(range_max)),
             number(range_min),
+        ));
+    }
+    if let Some(map) = &context.map
+        && range_max > 0.0
+        && range_max <= map.resolution
+    {
+        out.push(Finding::must_be(
+            path.key("range_max"),
+            format!(
+                "above map.resolution ({} m): the sensor must reach past its own voxel",
+                number(map.resolution)
+            ),
+            number(range_max),
+        ));
+    }
+}
+
+/// 0 < rate_hz <= physics_rate_hz: the sensing stage scans at most once per physics step.
+fn check_rate(path: &FieldPath, rate_hz: f64, context: &Context, out: &mut Vec<Finding>) {
+    positive(out, path.key("rate_hz"), rate_hz);
+    if let Some(physics) = context.physics_rate_hz
+        && rate_hz > physics
+    {
+        out.push(Finding::must_be(
+            path.key("rate_hz"),
+            format!(
+                "at most physics_rate_hz ({}): a sensor scans at most once per physics step",
+                number(physics)
+            ),
+            number(rate_hz),
+        ));
+    }
+}
+
+/// A mount within [`MAX_MOUNT_OFFSET_M`] of the UAV's centre.
+fn check_mount(path: &FieldPath, mount: &MountSpec, out: &mut Vec<Finding>) {
+    let [x, y, z] = mount.translation;
+    let offset = (x * x + y * y + z * z).sqrt();
+    if offset > MAX_MOUNT_OFFSET_M {
+        out.push(Finding::must_be(
+            path.key("mount").key("translation"),
+            format!("within {MAX_MOUNT_OFFSET_M} m of the UAV's centre"),
+            triple(mount.translation),
         ));
     }
 }

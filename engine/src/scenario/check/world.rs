@@ -1,7 +1,8 @@
 //! Checks of the run settings, the map (common.md §1) and the world: bounds and obstacles.
 
 use super::{
-    MAX_PILLARS, MAX_STEPS, MAX_VOXELS, MIN_VOXELS_PER_SIDE, non_negative, positive, probability,
+    MAX_PILLARS, MAX_STEPS, MAX_VOXELS, MIN_PHYSICS_RATE_HZ, MIN_VOXELS_PER_SIDE, non_negative,
+    positive, probability, usable,
 };
 use crate::scenario::diagnostic::{Finding, number};
 use crate::scenario::path::FieldPath;
@@ -16,17 +17,25 @@ pub(crate) struct Context {
     pub bounds: Option<BoundsSpec>,
     /// The map, when its resolution is finite and above 0.
     pub map: Option<MapSpec>,
+    /// The physics rate (Hz), when the top level decoded and the rate is valid.
+    pub physics_rate_hz: Option<f64>,
 }
 
 impl Context {
-    pub fn of(map: Option<&MapSpec>, bounds: Option<&BoundsSpec>) -> Self {
+    pub fn of(
+        map: Option<&MapSpec>,
+        bounds: Option<&BoundsSpec>,
+        physics_rate_hz: Option<f64>,
+    ) -> Self {
         let bounds = bounds.filter(|b| {
-            (0..3).all(|k| b.min[k].is_finite() && b.max[k].is_finite() && b.min[k] < b.max[k])
+            (0..3).all(|k| usable(b.min[k]) && usable(b.max[k]) && b.min[k] < b.max[k])
         });
-        let map = map.filter(|m| m.resolution.is_finite() && m.resolution > 0.0);
+        let map = map.filter(|m| usable(m.resolution) && m.resolution > 0.0);
         Self {
             bounds: bounds.copied(),
             map: map.cloned(),
+            physics_rate_hz: physics_rate_hz
+                .filter(|r| r.is_finite() && *r >= super::MIN_PHYSICS_RATE_HZ),
         }
     }
 }
@@ -45,11 +54,16 @@ pub(crate) fn check_run(root: &Scenario, out: &mut Vec<Finding>) {
         FieldPath::root().key("time_limit_s"),
         root.time_limit_s,
     );
-    positive(
-        out,
-        FieldPath::root().key("physics_rate_hz"),
-        root.physics_rate_hz,
-    );
+    if root.physics_rate_hz < MIN_PHYSICS_RATE_HZ {
+        out.push(Finding::must_be(
+            FieldPath::root().key("physics_rate_hz"),
+            format!(
+                "at least {MIN_PHYSICS_RATE_HZ} Hz (the motors' 0.033 s lag and the attitude \
+                 loop diverge at longer steps; common.md §3 runs at 300 Hz)"
+            ),
+            number(root.physics_rate_hz),
+        ));
+    }
     let steps = root.time_limit_s * root.physics_rate_hz;
     if root.physics_rate_hz > 0.0 && steps > MAX_STEPS {
         let longest = MAX_STEPS / root.physics_rate_hz;

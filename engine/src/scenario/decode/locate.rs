@@ -5,7 +5,7 @@ use serde::de::DeserializeOwned;
 use super::try_decode;
 use crate::scenario::de::{DeError, DeErrorKind};
 use crate::scenario::path::{FieldPath, Segment};
-use crate::scenario::tree::Node;
+use crate::scenario::tree::{Node, Value};
 
 /// Trial decodings spent locating one problem (see `blame`); a bisection needs about
 /// log2(values) per level, so this is only reached by absurd files.
@@ -29,16 +29,44 @@ pub(super) fn locate<T: DeserializeOwned>(
             }
             find_unknown_key(target, at, field, expected).unwrap_or_else(|| at.clone())
         }
-        DeErrorKind::UnknownVariant { .. } => {
-            if at.last_key() != Some("kind") && target.get(&[key("kind")]).is_some() {
-                at.key("kind")
-            } else {
-                at.clone()
+        DeErrorKind::UnknownVariant { variant, .. } if at.last_key() != Some("kind") => {
+            // The tag itself, unless the unknown name is another value of the table (such as
+            // an exploration `strategy`), which serde reports at the table too.
+            match target.get(&[key("kind")]).map(|tag| &tag.value) {
+                Some(Value::String(tag)) if tag == variant => at.key("kind"),
+                Some(_) if target.is_container() => blame::<T>(node, root, at, error),
+                Some(_) => at.key("kind"),
+                None => at.clone(),
             }
         }
+        DeErrorKind::UnknownVariant { .. } => at.clone(),
         _ if target.is_container() => blame::<T>(node, root, at, error),
         _ => at.clone(),
     }
+}
+
+/// The table a missing field belongs to. serde names it, except inside a `kind` table, whose
+/// buffered content names the `kind` table for a field missing in a table nested in it (an
+/// empty `energy_budget = {}`): then the nested table that brings the problem in, if any.
+pub(super) fn locate_missing<T: DeserializeOwned>(
+    node: &Node,
+    root: &FieldPath,
+    at: &FieldPath,
+    error: &DeError,
+) -> FieldPath {
+    let is_kind_table = at
+        .strip_prefix(root)
+        .and_then(|rel| node.get(rel))
+        .is_some_and(|table| table.get(&[key("kind")]).is_some());
+    if !is_kind_table {
+        return at.clone();
+    }
+    let culprit = blame::<T>(node, root, at, error);
+    let nested_table = culprit
+        .strip_prefix(root)
+        .and_then(|rel| node.get(rel))
+        .is_some_and(|value| matches!(value.value, Value::Table(_)));
+    if nested_table { culprit } else { at.clone() }
 }
 
 fn key(name: &str) -> Segment {
@@ -147,7 +175,7 @@ fn same_problem(a: &DeError, b: &DeError) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::scenario::schema::SensorSpec;
+    use crate::scenario::schema::{BehaviourSpec, SensorSpec};
     use crate::scenario::tree::parse_document;
 
     /// The path an error of a sensor table is narrowed down to (inside a `kind` table serde
@@ -192,6 +220,43 @@ mod tests {
         );
         // A tag that is no string is the culprit itself.
         assert_eq!(culprit("width = 640\nkind = 3\n"), "uav[0].sensor[0].kind");
+    }
+
+    #[test]
+    fn errors_inside_an_exploration_behaviour_name_their_field() {
+        let root = FieldPath::parse("uav[0].behaviour");
+        let culprit = |text: &str| {
+            let tree = parse_document(text).unwrap();
+            let error = try_decode::<BehaviourSpec>(&tree, &root).unwrap_err();
+            let at = error.path.clone().unwrap();
+            match error.kind {
+                DeErrorKind::MissingField { .. } => {
+                    locate_missing::<BehaviourSpec>(&tree, &root, &at, &error).to_string()
+                }
+                _ => locate::<BehaviourSpec>(&tree, &root, &at, &error).to_string(),
+            }
+        };
+        let explore = "kind = \"explore\"\n";
+        // These used to blame `kind` ("unknown behaviour 'greedy'") or the behaviour table.
+        assert_eq!(
+            culprit(&format!("{explore}strategy = \"greedy\"\n")),
+            "uav[0].behaviour.strategy"
+        );
+        assert_eq!(
+            culprit(&format!(
+                "{explore}strategy = \"eaae\"\nevaluate = \"most\"\n"
+            )),
+            "uav[0].behaviour.evaluate"
+        );
+        assert_eq!(
+            culprit(&format!(
+                "{explore}strategy = \"eaae\"\nenergy_budget = {{}}\n"
+            )),
+            "uav[0].behaviour.energy_budget"
+        );
+        // A field missing from the behaviour itself, and an unknown kind, stay where they were.
+        assert_eq!(culprit(explore), "uav[0].behaviour");
+        assert_eq!(culprit("kind = \"hover\"\n"), "uav[0].behaviour.kind");
     }
 
     #[test]

@@ -132,24 +132,34 @@ pub(super) fn finding(
             .expected(expected)
             .found(format!("{len} elements"))
         }
-        DeErrorKind::Custom(message) if message.contains("untagged enum RayGridSpec") => {
-            let expected = "\"auto\" or [columns, rows]";
-            let found = culprit
-                .strip_prefix(root)
-                .and_then(|rel| node.get(rel))
-                .map(describe)
-                .unwrap_or_else(|| "something else".to_owned());
-            Finding::new(
-                culprit.clone(),
-                Anchor::Value,
-                format!("expected {expected}"),
-            )
-            .expected(expected)
-            .found(found)
-        }
-        DeErrorKind::Custom(message) => {
-            Finding::new(culprit.clone(), Anchor::Value, message.clone())
-        }
+        DeErrorKind::Custom(message) => match untagged_expected(message) {
+            Some(expected) => {
+                let found = culprit
+                    .strip_prefix(root)
+                    .and_then(|rel| node.get(rel))
+                    .map(describe)
+                    .unwrap_or_else(|| "something else".to_owned());
+                Finding::new(
+                    culprit.clone(),
+                    Anchor::Value,
+                    format!("expected {expected}"),
+                )
+                .expected(expected)
+                .found(found)
+            }
+            None => Finding::new(culprit.clone(), Anchor::Value, message.clone()),
+        },
+    }
+}
+
+/// What the schema's untagged enums take, for serde's "data did not match any variant of
+/// untagged enum X", which names a Rust type the reader of a file does not know.
+fn untagged_expected(message: &str) -> Option<&'static str> {
+    let name = message.strip_prefix("data did not match any variant of untagged enum ")?;
+    match name.trim() {
+        "RayGridSpec" => Some("\"auto\" or [columns, rows]"),
+        "CandidateCount" => Some("a whole number of clusters, or \"all\""),
+        _ => None,
     }
 }
 

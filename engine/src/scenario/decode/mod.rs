@@ -19,7 +19,7 @@ use super::source_map::Anchor;
 use super::suggest::closest;
 use super::tree::{Element, Node, Value};
 
-use locate::locate;
+use locate::{locate, locate_missing};
 use messages::{finding, missing_field};
 
 /// Problems reported per unit (an entry); past this, the entry is only said to have more. Each
@@ -190,6 +190,7 @@ fn decode_unit<T: DeserializeOwned>(
         }
         let at = error.path.clone().unwrap_or_else(|| root.clone());
         let cut = if let DeErrorKind::MissingField { field } = &error.kind {
+            let at = locate_missing::<T>(&node, root, &at, &error);
             // A value we cut out earlier is not missing a second time.
             if !removed.contains(&at.key(field)) {
                 findings.push(missing_field(&at, field));
@@ -215,19 +216,14 @@ fn decode_unit<T: DeserializeOwned>(
     }
 }
 
-/// Every non-finite number in the file (`nan`, `inf`, or a literal too large for 64 bits):
-/// none of the scenario's quantities can take one.
+/// Every number in the file that no quantity of a scenario can take (`nan`, `inf`, a literal too
+/// large for 64 bits, or one beyond the 32-bit floats of the geometry:
+/// [`crate::scenario::check::unusable_number`]).
 pub(crate) fn non_finite(tree: &Node) -> Vec<Finding> {
     let mut findings = Vec::new();
     tree.walk(&FieldPath::root(), &mut |path, node| {
-        if let Value::Float(x) = node.value
-            && !x.is_finite()
-        {
-            findings.push(Finding::must_be(
-                path.clone(),
-                "a finite number",
-                format!("{x}"),
-            ));
+        if let Value::Float(x) = node.value {
+            findings.extend(crate::scenario::check::unusable_number(path, x));
         }
     });
     findings

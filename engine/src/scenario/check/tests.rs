@@ -317,6 +317,19 @@ fn sensor_quality() {
             "-0.01"
         )
     );
+    // The default camera reaches 5 m.
+    assert_eq!(
+        one(&camera("quality = { range_noise_std = 1e30 }")),
+        finding(
+            "uav[0].sensor[0].quality.range_noise_std",
+            "must be below range_max (5.0 m)",
+            "1e30"
+        )
+    );
+    assert_eq!(
+        findings(&camera("quality = { range_noise_std = 0.05 }")),
+        vec![]
+    );
 }
 
 #[test]

@@ -244,7 +244,7 @@ pub(crate) fn check_sensor(
             check_ranges(path, *range_min, *range_max, context, out);
             check_rate(path, *rate_hz, context, out);
             check_mount(path, mount, out);
-            check_quality(path, quality, out);
+            check_quality(path, quality, *range_max, out);
             let rays = match ray_grid {
                 RayGridSpec::Explicit([columns, rows]) => {
                     at_least_one(out, path.key("ray_grid").index(0), *columns);
@@ -283,7 +283,7 @@ pub(crate) fn check_sensor(
             check_ranges(path, *range_min, *range_max, context, out);
             check_rate(path, *rate_hz, context, out);
             check_mount(path, mount, out);
-            check_quality(path, quality, out);
+            check_quality(path, quality, *range_max, out);
             check_ray_count(
                 &path.key("beams_h"),
                 Some(f64::from(*beams_h) * f64::from(*beams_v)),
@@ -356,10 +356,25 @@ fn check_mount(path: &FieldPath, mount: &MountSpec, out: &mut Vec<Finding>) {
     }
 }
 
-fn check_quality(sensor: &FieldPath, quality: &QualitySpec, out: &mut Vec<Finding>) {
+/// The sensor model, and range noise below the range itself (a standard deviation of 1e30 m
+/// scattered every reading to the range limit and "explored" more than a perfect sensor).
+fn check_quality(
+    sensor: &FieldPath,
+    quality: &QualitySpec,
+    range_max: f64,
+    out: &mut Vec<Finding>,
+) {
     let path = sensor.key("quality");
     check_hit_miss(&path, quality.p_hit, quality.p_miss, out);
-    non_negative(out, path.key("range_noise_std"), quality.range_noise_std);
+    let noise = quality.range_noise_std;
+    non_negative(out, path.key("range_noise_std"), noise);
+    if noise > 0.0 && range_max > 0.0 && noise >= range_max {
+        out.push(Finding::must_be(
+            path.key("range_noise_std"),
+            format!("below range_max ({} m)", number(range_max)),
+            number(noise),
+        ));
+    }
 }
 
 /// Rays per frame of the "auto" grid, estimated as the sensing stage builds it (common.md §2:

@@ -62,6 +62,10 @@ pub enum CoverageIoError {
     Picture { path: PathBuf, message: String },
     #[error(transparent)]
     Mission(#[from] MissionError),
+    /// Planning failed because of a coverage setting (`field`, below the behaviour). No file is
+    /// named: the caller knows the scenario (`uavex cover` puts it in front).
+    #[error("coverage {field}: {source}")]
+    Plan { field: String, source: MissionError },
     /// A simulated flight (calibration or flying a plan) failed.
     #[error("simulated flight: {0}")]
     Flight(String),

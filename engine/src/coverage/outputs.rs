@@ -28,6 +28,10 @@ pub fn write_plan(
     dir: &Path,
     stem: &str,
 ) -> Result<PlanFiles, CoverageIoError> {
+    plain_file_stem(stem).map_err(|message| CoverageIoError::Content {
+        path: dir.to_owned(),
+        message,
+    })?;
     std::fs::create_dir_all(dir).map_err(|source| CoverageIoError::Io {
         path: dir.to_owned(),
         source,
@@ -45,6 +49,25 @@ pub fn write_plan(
     write_picture(polygon, plan, &files.png)?;
     write_picture(polygon, plan, &files.svg)?;
     Ok(files)
+}
+
+/// Checks that `stem` names files inside the output folder: one plain path component, no
+/// separator, no `.` or `..`, not absolute. Names are refused rather than rewritten: a rewritten
+/// name would write files the user did not name, and two names could map onto one.
+pub fn plain_file_stem(stem: &str) -> Result<(), String> {
+    let mut components = Path::new(stem).components();
+    let plain = matches!(
+        (components.next(), components.next()),
+        (Some(std::path::Component::Normal(c)), None) if c == stem
+    ) && !stem.contains(['/', '\\', '\0', ':']);
+    if plain {
+        Ok(())
+    } else {
+        Err(format!(
+            "`{stem}` cannot name output files: it must be a plain file name (no `/`, `\\`, `:`, \
+             `..`, not empty), as the files are written inside the output folder"
+        ))
+    }
 }
 
 fn csv_error(path: &Path) -> impl Fn(csv::Error) -> CoverageIoError + '_ {
@@ -308,6 +331,23 @@ mod tests {
         assert_eq!(&png[1..4], b"PNG");
         let svg = std::fs::read_to_string(&files.svg).unwrap();
         assert!(svg.contains("<svg") && svg.contains("<polygon"));
+    }
+
+    #[test]
+    fn a_stem_with_a_path_in_it_writes_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let out = dir.path().join("out");
+        let (field, plan) = plan();
+        let absolute = dir.path().join("abs").display().to_string();
+        for stem in ["../escape", absolute.as_str(), "a/b", "..", ""] {
+            let err = write_plan(&field, &plan, None, &out, stem)
+                .unwrap_err()
+                .to_string();
+            assert!(err.contains("plain file name"), "{stem}: {err}");
+        }
+        // Nothing was written anywhere, not even the output folder.
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        assert_eq!(plain_file_stem("field_2.v1"), Ok(()));
     }
 
     #[test]

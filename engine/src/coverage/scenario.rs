@@ -3,6 +3,7 @@
 //! nothing else of the scenario (world, map, sensors) to be valid or even present.
 
 use super::CoverageIoError;
+use super::outputs::plain_file_stem;
 use super::spec::CoverageSpec;
 use serde::Deserialize;
 use std::collections::BTreeMap;
@@ -54,6 +55,9 @@ pub fn read_coverage_scenario(path: &Path) -> Result<CoverageScenario, CoverageI
             .file_stem()
             .map_or("scenario".to_owned(), |s| s.to_string_lossy().into_owned()),
     };
+    // `uavex cover` names its output files after the scenario: a name with a path in it would
+    // write outside the output folder.
+    plain_file_stem(&name).map_err(|message| content(format!("name: {message}")))?;
     let uavs = match table.get("uav") {
         Some(toml::Value::Array(uavs)) => uavs.as_slice(),
         _ => &[],
@@ -155,5 +159,26 @@ available_energy_j = 90000.0
             error.contains("uav[0].behaviour") && error.contains("areaa"),
             "{error}"
         );
+    }
+
+    #[test]
+    fn a_name_that_would_write_outside_the_output_folder_is_refused() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("s.toml");
+        let coverage = "[[uav]]\nname = \"a\"\n[uav.behaviour]\nkind = \"coverage\"\n\
+                        area = { vertices = [[0, 0], [10, 0], [0, 10]] }\n\
+                        camera = { angle_of_view = 1.2, width_px = 400, height_px = 300, \
+                        shot_period_s = 1.0 }\noverlap = { x = 0.2, y = 0.3 }\n\
+                        resolution_px_per_m = 10.0\navailable_energy_j = 1e5\n";
+        for name in ["../../escape_cov", "/tmp/abs", "a/b", "..", ".", ""] {
+            std::fs::write(&path, format!("name = {name:?}\n{coverage}")).unwrap();
+            let error = read_coverage_scenario(&path).unwrap_err().to_string();
+            assert!(
+                error.contains("name: ") && error.contains("plain file name"),
+                "{name}: {error}"
+            );
+        }
+        std::fs::write(&path, format!("name = \"field 2.v1\"\n{coverage}")).unwrap();
+        assert_eq!(read_coverage_scenario(&path).unwrap().name, "field 2.v1");
     }
 }

@@ -25,8 +25,8 @@ use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 use uavex_systems::coverage::{
-    AltitudeOutcome, AltitudeSearch, Camera, CoverageProblem, Overlaps, Polygon, ScanDirection,
-    SpeedEnergyModel, search_altitude,
+    AltitudeOutcome, AltitudeSearch, Camera, CameraError, CoverageProblem, MissionError, Overlaps,
+    PathError, Polygon, PolygonError, ScanDirection, SpeedEnergyModel, search_altitude,
 };
 
 /// What a coverage mission surveys, with what, and on how much energy.
@@ -94,7 +94,7 @@ impl CoverageSpec {
             field: field.to_owned(),
             message,
         };
-        let (vertices, projection, origin) = match (&self.area.vertices, &self.area.file) {
+        let (vertices, projection) = match (&self.area.vertices, &self.area.file) {
             (Some(vertices), None) => {
                 if self.area.coordinates == Some(Coordinates::Lonlat) {
                     return Err(spec_error(
@@ -103,12 +103,13 @@ impl CoverageSpec {
                     ));
                 }
                 let points = vertices.iter().map(|&[x, y]| DVec2::new(x, y)).collect();
-                (points, None, source.to_owned())
+                (points, None)
             }
             (None, Some(file)) => {
                 let path = base_dir.join(file);
-                let field = read_field(&path, self.area.coordinates)?;
-                (field.vertices, field.projection, path)
+                let field = read_field(&path, self.area.coordinates)
+                    .map_err(|e| spec_error("area.file", e.to_string()))?;
+                (field.vertices, field.projection)
             }
             _ => {
                 return Err(spec_error(
@@ -119,9 +120,13 @@ impl CoverageSpec {
             }
         };
         let count = vertices.len();
-        let polygon = Polygon::new(vertices).map_err(|source| CoverageIoError::Polygon {
-            path: origin,
-            source,
+        let polygon = Polygon::new(vertices).map_err(|e| match &self.area.file {
+            // The file's problem, with the file named.
+            Some(file) => spec_error(
+                "area.file",
+                format!("{}: {e}", base_dir.join(file).display()),
+            ),
+            None => spec_error(&polygon_field(&e), e.to_string()),
         })?;
         let start_vertex = polygon.index_of_input(self.start_vertex).ok_or_else(|| {
             spec_error(
@@ -135,10 +140,8 @@ impl CoverageSpec {
         })?;
         self.camera
             .validate()
-            .map_err(|e| spec_error("camera", e.to_string()))?;
-        self.overlap
-            .validate()
-            .map_err(|e| spec_error("overlap", e.to_string()))?;
+            .and_then(|()| self.overlap.validate())
+            .map_err(|e| spec_error(camera_field(&e, &self.camera), e.to_string()))?;
         if !(self.resolution_px_per_m > 0.0 && self.resolution_px_per_m.is_finite()) {
             return Err(spec_error(
                 "resolution_px_per_m",
@@ -151,7 +154,18 @@ impl CoverageSpec {
                 format!("must be positive, got {}", self.available_energy_j),
             ));
         }
-        let model = load_energy_model(&self.energy_model, base_dir)?;
+        if self.energy_model.trim().is_empty() {
+            return Err(spec_error(
+                "energy_model",
+                format!(
+                    "must name a preset ({}) or a model file (.json or .toml), got `{}`",
+                    SpeedEnergyModel::PRESETS.join(", "),
+                    self.energy_model
+                ),
+            ));
+        }
+        let model = load_energy_model(&self.energy_model, base_dir)
+            .map_err(|e| spec_error("energy_model", e.to_string()))?;
         Ok(CoverageSetup {
             problem: CoverageProblem {
                 polygon,
@@ -173,12 +187,16 @@ impl CoverageSetup {
     /// The altitude search of coverage.md: the plan at the best feasible altitude, or the
     /// verdict that the battery does not suffice.
     pub fn plan(&self) -> Result<AltitudeOutcome, CoverageIoError> {
-        Ok(search_altitude(
+        search_altitude(
             &self.problem,
             &self.model,
             self.available_energy_j,
             &self.search,
-        )?)
+        )
+        .map_err(|source| CoverageIoError::Plan {
+            field: mission_field(&source, &self.problem.camera).to_owned(),
+            source,
+        })
     }
 
     /// The text `uavex cover` prints.
@@ -205,6 +223,49 @@ impl CoverageSetup {
             dir,
             stem,
         )
+    }
+}
+
+/// The spec field (below the behaviour) an inline polygon's problem is about.
+fn polygon_field(error: &PolygonError) -> String {
+    match error {
+        PolygonError::NonFinite { index, .. } | PolygonError::TooFar { index, .. } => {
+            format!("area.vertices[{index}]")
+        }
+        PolygonError::RepeatedVertex { second, .. } => format!("area.vertices[{second}]"),
+        _ => "area.vertices".to_owned(),
+    }
+}
+
+/// The spec field a camera or overlap problem is about.
+fn camera_field(error: &CameraError, camera: &Camera) -> &'static str {
+    match error {
+        CameraError::AngleOfView(_) => "camera.angle_of_view",
+        CameraError::ImageSize { .. } if camera.width_px == 0 => "camera.width_px",
+        CameraError::ImageSize { .. } => "camera.height_px",
+        CameraError::ShotPeriod(_) => "camera.shot_period_s",
+        CameraError::Overlap { axis: 'x', .. } => "overlap.x",
+        CameraError::Overlap { .. } => "overlap.y",
+        CameraError::Altitude(_) => "altitude",
+        CameraError::Resolution(_) => "resolution_px_per_m",
+    }
+}
+
+/// The spec field a planning problem is about. Problems of size (too many photos, an area
+/// thinner than the tolerance) come from the area against the footprint; their messages give
+/// the spacings and what would shrink the count.
+fn mission_field(error: &MissionError, camera: &Camera) -> &'static str {
+    match error {
+        MissionError::Camera(e) => camera_field(e, camera),
+        MissionError::Path(PathError::StartVertex { .. }) => "start_vertex",
+        MissionError::Path(_) => "area",
+        MissionError::EnergyModel(_) | MissionError::LegEnergy { .. } => "energy_model",
+        MissionError::AvailableEnergy(_) | MissionError::FarBeyondBattery { .. } => {
+            "available_energy_j"
+        }
+        MissionError::Search { .. } => "altitude",
+        MissionError::StepTooSmall { .. } | MissionError::TooManySteps { .. } => "altitude.step_m",
+        MissionError::ResolutionUnreachable { .. } => "resolution_px_per_m",
     }
 }
 
@@ -327,7 +388,7 @@ mod tests {
         );
         let err = resolve(&SPEC.replace("x = 0.2", "x = 1.5"));
         assert!(
-            err.contains("overlap: overlap along x must lie in [0, 1)"),
+            err.contains("coverage overlap.x: overlap along x must lie in [0, 1)"),
             "{err}"
         );
         let err = resolve(&SPEC.replace(
@@ -340,5 +401,65 @@ mod tests {
             "area = {}",
         ));
         assert!(err.contains("give exactly one of `vertices`"), "{err}");
+        // An empty model name names the scenario and the field, not a blank path.
+        let err = resolve(&SPEC.replace(
+            "area = { vertices",
+            "energy_model = \"\"\narea = { vertices",
+        ));
+        assert!(
+            err.starts_with("s.toml: coverage energy_model: must name a preset (iris)"),
+            "{err}"
+        );
+        let err = resolve(&SPEC.replace("[300, 150]", "[300, 1e30]"));
+        assert!(
+            err.starts_with("s.toml: coverage area.vertices[2]: vertex 2"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_negative_power_model_file_is_refused_with_its_field() {
+        let dir = tempfile::tempdir().unwrap();
+        let mut negative = SpeedEnergyModel::iris();
+        negative.level.coefficients = vec![0.0, 0.0, 0.0, 0.0, -123.0];
+        std::fs::write(
+            dir.path().join("neg.json"),
+            serde_json::to_string(&negative).unwrap(),
+        )
+        .unwrap();
+        let text = SPEC.replace(
+            "area = { vertices",
+            "energy_model = \"neg.json\"\narea = { vertices",
+        );
+        let err = toml::from_str::<CoverageSpec>(&text)
+            .unwrap()
+            .resolve(dir.path(), Path::new("s.toml"))
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("s.toml: coverage energy_model: "), "{err}");
+        assert!(
+            err.contains("neg.json") && err.contains("level.coefficients give -123"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn planning_problems_name_the_field() {
+        let plan = |text: &str| {
+            toml::from_str::<CoverageSpec>(text)
+                .unwrap()
+                .resolve(Path::new("."), Path::new("s.toml"))
+                .unwrap()
+                .plan()
+                .unwrap_err()
+                .to_string()
+        };
+        let err = plan(&SPEC.replace("y = 0.3", "y = 0.999999999"));
+        assert!(err.starts_with("coverage area: covering the area"), "{err}");
+        let err = plan(&SPEC.replace(
+            "altitude = { step_m = 0.5 }",
+            "altitude = { step_m = 1e-30, min_altitude_m = 10.0, max_altitude_m = 10.0 }",
+        ));
+        assert!(err.starts_with("coverage altitude.step_m: "), "{err}");
     }
 }

@@ -25,6 +25,27 @@ pub enum EnergyModelError {
     },
     #[error("energy model `{model}`: the {curve} power curve needs finite coefficients")]
     Curve { model: String, curve: &'static str },
+    #[error(
+        "energy model `{model}`: {curve}.coefficients has {count} coefficients, at most {limit} \
+         (a polynomial of degree {limit} - 1) are accepted"
+    )]
+    TooManyCoefficients {
+        model: String,
+        curve: &'static str,
+        count: usize,
+        limit: usize,
+    },
+    #[error(
+        "energy model `{model}`: {curve}.coefficients give {power_w:.4} W at {speed:.4} m/s: power \
+         must be positive at every speed it is used at, 0 to max_speed ({max_speed} m/s)"
+    )]
+    NonPositivePower {
+        model: String,
+        curve: &'static str,
+        speed: f64,
+        power_w: f64,
+        max_speed: f64,
+    },
     #[error("a leg length must be non-negative and finite (m), got {0}")]
     Distance(f64),
     #[error(
@@ -150,6 +171,14 @@ impl SpeedEnergyModel {
 
     pub const PRESETS: &[&str] = &["iris"];
 
+    /// Most coefficients of a power curve: the published and fitted curves have 5 or 6, and
+    /// every evaluation costs one multiply-add per coefficient.
+    pub const MAX_COEFFICIENTS: usize = 16;
+
+    /// Speeds at which [`Self::validate`] checks that power is positive: evenly spaced over
+    /// `[0, max_speed]`, ends included.
+    const POWER_CHECKS: usize = 1024;
+
     pub fn validate(&self) -> Result<(), EnergyModelError> {
         let positive = [
             ("acceleration", self.acceleration),
@@ -180,6 +209,25 @@ impl SpeedEnergyModel {
                 return Err(EnergyModelError::Curve {
                     model: self.name.clone(),
                     curve,
+                });
+            }
+            if c.coefficients.len() > Self::MAX_COEFFICIENTS {
+                return Err(EnergyModelError::TooManyCoefficients {
+                    model: self.name.clone(),
+                    curve,
+                    count: c.coefficients.len(),
+                    limit: Self::MAX_COEFFICIENTS,
+                });
+            }
+            if let Some((speed, power_w)) =
+                first_non_positive(c, self.max_speed, Self::POWER_CHECKS)
+            {
+                return Err(EnergyModelError::NonPositivePower {
+                    model: self.name.clone(),
+                    curve,
+                    speed,
+                    power_w,
+                    max_speed: self.max_speed,
                 });
             }
         }
@@ -305,6 +353,17 @@ impl SpeedEnergyModel {
     pub fn turn_time(&self, angle: f64) -> f64 {
         angle.abs() / self.turn.rate
     }
+}
+
+/// The first of `samples + 1` evenly spaced speeds over `[0, max_speed]` where `curve` gives no
+/// positive, finite power, with that power. A power model must draw power at every speed it is
+/// flown at (coverage.md, "Measured energy model"); a fit that dips below zero would price legs
+/// at negative energy and call any mission feasible.
+fn first_non_positive(curve: &PowerCurve, max_speed: f64, samples: usize) -> Option<(f64, f64)> {
+    (0..=samples)
+        .map(|i| max_speed * i as f64 / samples as f64)
+        .map(|v| (v, curve.power(v)))
+        .find(|&(_, p)| !(p > 0.0 && p.is_finite()))
 }
 
 /// Minimises `f` over `(0, hi]`: a scan of 64 evenly spaced speeds finds the best bracket (the

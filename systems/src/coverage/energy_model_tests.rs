@@ -251,3 +251,45 @@ fn bad_requests_are_errors() {
         Err(EnergyModelError::Curve { .. })
     ));
 }
+
+#[test]
+fn power_must_be_positive_wherever_a_curve_is_used() {
+    assert_eq!(SpeedEnergyModel::iris().validate(), Ok(()));
+    // The fuzzed model: level power -123 W at every speed ("feasible", -9e10 kJ).
+    let mut negative = SpeedEnergyModel::iris();
+    negative.level = PowerCurve::polynomial(vec![0.0, 0.0, 0.0, 0.0, -123.0]);
+    let err = negative.validate().unwrap_err();
+    assert!(
+        matches!(
+            err,
+            EnergyModelError::NonPositivePower {
+                curve: "level",
+                speed: 0.0,
+                ..
+            }
+        ),
+        "{err}"
+    );
+    assert!(err.to_string().contains("level.coefficients"), "{err}");
+    // Positive at hover, negative near the top speed: found at the speed where it dips.
+    let mut dips = SpeedEnergyModel::iris();
+    dips.decelerating = PowerCurve::polynomial(vec![-10.0, 100.0]);
+    let Err(EnergyModelError::NonPositivePower { curve, speed, .. }) = dips.validate() else {
+        panic!("a curve crossing zero at 10 m/s was accepted")
+    };
+    assert_eq!(curve, "decelerating");
+    assert!((10.0..10.1).contains(&speed), "{speed}");
+    // Beyond max_speed the curve is never used, so it may do what it likes there.
+    dips.max_speed = 9.0;
+    assert_eq!(dips.validate(), Ok(()));
+}
+
+#[test]
+fn power_curves_have_bounded_degree() {
+    let mut long = SpeedEnergyModel::iris();
+    long.accelerating = PowerCurve::polynomial(vec![1e-30; 1000]);
+    assert!(matches!(
+        long.validate(),
+        Err(EnergyModelError::TooManyCoefficients { count: 1000, .. })
+    ));
+}

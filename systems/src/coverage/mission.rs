@@ -31,6 +31,36 @@ pub enum MissionError {
         max_altitude_m: f64,
     },
     #[error(
+        "altitude search: step {step_m:?} m is below {min_step_m} m, finer than any altitude is \
+         flown"
+    )]
+    StepTooSmall { step_m: f64, min_step_m: f64 },
+    #[error(
+        "altitude search: {steps:.0} steps of {step_m} m between {min_altitude_m} m and \
+         {max_altitude_m} m, more than the {limit} re-plans allowed"
+    )]
+    TooManySteps {
+        steps: f64,
+        step_m: f64,
+        min_altitude_m: f64,
+        max_altitude_m: f64,
+        limit: usize,
+    },
+    #[error(
+        "the plan needs {energy_j:.4e} J, more than {limit} times the {available_j} J available \
+         (its slowest leg is flown at {slowest_mps:.3e} m/s): no count of flights is meaningful"
+    )]
+    FarBeyondBattery {
+        energy_j: f64,
+        available_j: f64,
+        slowest_mps: f64,
+        limit: u32,
+    },
+    #[error(
+        "leg {leg} of the plan prices at {energy_j} J: the energy model gives no positive energy"
+    )]
+    LegEnergy { leg: usize, energy_j: f64 },
+    #[error(
         "the required resolution needs flying at {required_m:.2} m or lower, below the minimum \
          altitude {min_altitude_m} m"
     )]
@@ -161,6 +191,18 @@ pub fn price(
             })
         })
         .collect::<Result<Vec<_>, EnergyModelError>>()?;
+    // The model's curves are checked positive where they are used; this catches anything they
+    // still let through (a dip between the checked speeds) before it becomes a "feasible" plan.
+    if let Some((leg, l)) = legs
+        .iter()
+        .enumerate()
+        .find(|(_, l)| !(l.energy_j >= 0.0 && l.energy_j.is_finite()))
+    {
+        return Err(MissionError::LegEnergy {
+            leg,
+            energy_j: l.energy_j,
+        });
+    }
     let turns: Vec<TurnPlan> = legs
         .windows(2)
         .map(|w| {
@@ -261,6 +303,17 @@ pub struct AltitudeOutcome {
     pub trials: Vec<AltitudeTrial>,
 }
 
+/// Most re-plans of one altitude search (each a whole path).
+pub const MAX_ALTITUDE_STEPS: usize = 100_000;
+
+/// Finest altitude step (m): altitudes are not flown to better than a millimetre, and a finer
+/// step would re-plan the same path over and over.
+pub const MIN_ALTITUDE_STEP_M: f64 = 1e-3;
+
+/// Most battery loads an infeasible verdict counts; a plan needing more is nonsense (e.g. a shot
+/// period that crawls the UAV along) and is refused rather than given a saturated count.
+pub const MAX_FLIGHTS: u32 = 1_000_000;
+
 /// Plans at `h_max`; if feasible, lowers the altitude step by step (more resolution), re-planning
 /// and re-testing, until `E_tot` is within the tolerance below `E_available` or the minimum
 /// altitude is reached, and keeps the lowest feasible plan (energy against altitude is not
@@ -276,19 +329,36 @@ pub fn search_altitude(
         return Err(MissionError::AvailableEnergy(available_j));
     }
     let valid = search.step_m > 0.0
+        && search.step_m.is_finite()
         && search.tolerance_j >= 0.0
         && search.min_altitude_m > 0.0
         && search.min_altitude_m <= search.max_altitude_m
         && search.max_altitude_m.is_finite()
-        && search.tolerance_j.is_finite()
-        // Bounded work: at most 100 000 re-plans.
-        && (search.max_altitude_m - search.min_altitude_m) / search.step_m <= 1e5;
+        && search.tolerance_j.is_finite();
     if !valid {
         return Err(MissionError::Search {
             step_m: search.step_m,
             tolerance_j: search.tolerance_j,
             min_altitude_m: search.min_altitude_m,
             max_altitude_m: search.max_altitude_m,
+        });
+    }
+    // Bounded work: a step below what altitude resolves would try one altitude again and again
+    // (h - k step rounds back to h), so both the step and the number of steps are limited.
+    if search.step_m < MIN_ALTITUDE_STEP_M {
+        return Err(MissionError::StepTooSmall {
+            step_m: search.step_m,
+            min_step_m: MIN_ALTITUDE_STEP_M,
+        });
+    }
+    let steps = (search.max_altitude_m - search.min_altitude_m) / search.step_m;
+    if steps > MAX_ALTITUDE_STEPS as f64 {
+        return Err(MissionError::TooManySteps {
+            steps,
+            step_m: search.step_m,
+            min_altitude_m: search.min_altitude_m,
+            max_altitude_m: search.max_altitude_m,
+            limit: MAX_ALTITUDE_STEPS,
         });
     }
     let h_max = problem
@@ -314,42 +384,37 @@ pub fn search_altitude(
     let at_h_max = try_at(h_max)?;
     let (verdict, plan) = if at_h_max.is_feasible(available_j) {
         let mut best = at_h_max;
-        let mut k = 1.0;
-        while available_j - best.energy_j > search.tolerance_j {
-            let h = h_max - k * search.step_m;
-            if h < search.min_altitude_m {
+        // The loops run over step counts fixed up front, never over a float compared with a
+        // bound it may never cross.
+        for h in altitude_steps(h_max, search.min_altitude_m, -search.step_m) {
+            if available_j - best.energy_j <= search.tolerance_j {
                 break;
             }
             let plan = try_at(h)?;
             if plan.is_feasible(available_j) {
                 best = plan;
             }
-            k += 1.0;
         }
         (Verdict::Feasible, best)
     } else {
         let mut raised = None;
         if search.accept_lower_resolution {
-            let mut k = 1.0;
-            loop {
-                let h = h_max + k * search.step_m;
-                if h > search.max_altitude_m {
-                    break;
-                }
+            for h in altitude_steps(h_max, search.max_altitude_m, search.step_m) {
                 let plan = try_at(h)?;
                 if plan.is_feasible(available_j) {
                     raised = Some(plan);
                     break;
                 }
-                k += 1.0;
             }
         }
         match raised {
             Some(plan) => (Verdict::LowerResolution, plan),
-            None => {
-                let flights = (at_h_max.energy_j / available_j).ceil().max(2.0) as u32;
-                (Verdict::Infeasible { flights }, at_h_max)
-            }
+            None => (
+                Verdict::Infeasible {
+                    flights: flights_needed(&at_h_max, available_j)?,
+                },
+                at_h_max,
+            ),
         }
     };
     Ok(AltitudeOutcome {
@@ -358,6 +423,39 @@ pub fn search_altitude(
         required_altitude_m: h_max,
         available_energy_j: available_j,
         trials,
+    })
+}
+
+/// Altitudes `from + k step` for `k = 1, 2, ...` up to and including `limit` (`step` signed
+/// towards it): `floor(|limit - from| / |step|)` of them, a count fixed before the first re-plan.
+/// The caller bounds that count ([`MAX_ALTITUDE_STEPS`]).
+fn altitude_steps(from: f64, limit: f64, step: f64) -> impl Iterator<Item = f64> {
+    let count = ((limit - from) / step).floor();
+    let count = if count >= 1.0 {
+        (count as usize).min(MAX_ALTITUDE_STEPS)
+    } else {
+        0
+    };
+    (1..=count).map(move |k| from + k as f64 * step)
+}
+
+/// The battery loads an infeasible plan needs at least: `ceil(E_tot / E_available)`, at least 2.
+/// Refused above [`MAX_FLIGHTS`], where the count says nothing and would saturate.
+fn flights_needed(plan: &MissionPlan, available_j: f64) -> Result<u32, MissionError> {
+    let flights = (plan.energy_j / available_j).ceil().max(2.0);
+    if flights <= f64::from(MAX_FLIGHTS) {
+        return Ok(flights as u32);
+    }
+    Err(MissionError::FarBeyondBattery {
+        energy_j: plan.energy_j,
+        available_j,
+        slowest_mps: plan
+            .legs
+            .iter()
+            .map(|l| l.speed)
+            .filter(|&v| v > 0.0)
+            .fold(f64::INFINITY, f64::min),
+        limit: MAX_FLIGHTS,
     })
 }
 

@@ -173,3 +173,103 @@ fn bad_search_settings_are_errors() {
         Err(MissionError::ResolutionUnreachable { .. })
     ));
 }
+
+#[test]
+fn a_step_below_what_altitude_resolves_is_refused_not_looped_on() {
+    // min = max and a step far below the ulp of 10 m: h - k step rounds back to h for ever.
+    let search = AltitudeSearch {
+        step_m: 1e-30,
+        tolerance_j: 0.0,
+        min_altitude_m: 10.0,
+        max_altitude_m: 10.0,
+        accept_lower_resolution: false,
+    };
+    let iris = SpeedEnergyModel::iris();
+    let err = search_altitude(&problem(field()), &iris, 1e9, &search).unwrap_err();
+    assert!(matches!(err, MissionError::StepTooSmall { .. }), "{err}");
+    assert!(err.to_string().contains("below 0.001 m"), "{err}");
+    // A step that resolves, with nothing to lower into: exactly one plan, at 10 m.
+    let outcome = search_altitude(
+        &problem(field()),
+        &iris,
+        1e9,
+        &AltitudeSearch {
+            step_m: 1e-3,
+            ..search
+        },
+    )
+    .unwrap();
+    assert_eq!(outcome.trials.len(), 1);
+    assert_eq!(outcome.plan.survey.altitude_m, 10.0);
+}
+
+#[test]
+fn altitude_steps_are_counted_up_front() {
+    assert_eq!(altitude_steps(10.0, 10.0, -1e-3).count(), 0);
+    let down: Vec<f64> = altitude_steps(20.0, 17.5, -1.0).collect();
+    assert_eq!(down, vec![19.0, 18.0]);
+    let up: Vec<f64> = altitude_steps(20.0, 22.0, 1.0).collect();
+    assert_eq!(up, vec![21.0, 22.0]);
+    assert_eq!(altitude_steps(20.0, f64::NAN, 1.0).count(), 0);
+    // Never more than the limit, whatever the ratio.
+    assert_eq!(altitude_steps(0.0, 1e30, 1.0).count(), MAX_ALTITUDE_STEPS);
+}
+
+#[test]
+fn too_many_altitude_steps_name_the_step() {
+    let search = AltitudeSearch {
+        step_m: 1e-3,
+        min_altitude_m: 5.0,
+        max_altitude_m: 120.0,
+        ..AltitudeSearch::default()
+    };
+    let err =
+        search_altitude(&problem(field()), &SpeedEnergyModel::iris(), 1e9, &search).unwrap_err();
+    assert!(matches!(err, MissionError::TooManySteps { .. }), "{err}");
+}
+
+#[test]
+fn a_crawling_plan_is_refused_rather_than_given_a_saturated_flight_count() {
+    // A shot period of 1e30 s caps every leg at about 1e-29 m/s: the plan needs ~1e33 J.
+    let mut slow = problem(field());
+    slow.camera.shot_period_s = 1e30;
+    let err = search_altitude(
+        &slow,
+        &SpeedEnergyModel::iris(),
+        76_700.0,
+        &AltitudeSearch::default(),
+    )
+    .unwrap_err();
+    assert!(
+        matches!(err, MissionError::FarBeyondBattery { .. }),
+        "{err}"
+    );
+    assert!(err.to_string().contains("no count of flights"), "{err}");
+    // A plan a few batteries long still gets its count.
+    let outcome = search_altitude(
+        &problem(field()),
+        &SpeedEnergyModel::iris(),
+        10_000.0,
+        &AltitudeSearch::default(),
+    )
+    .unwrap();
+    let Verdict::Infeasible { flights } = outcome.verdict else {
+        panic!("{:?}", outcome.verdict)
+    };
+    assert_eq!(
+        f64::from(flights),
+        (outcome.plan.energy_j / 10_000.0).ceil().max(2.0)
+    );
+}
+
+#[test]
+fn a_model_pricing_a_leg_below_zero_energy_is_refused() {
+    // `price` takes any model; one drawing negative power must not give a "feasible" plan.
+    let mut negative = SpeedEnergyModel::iris();
+    negative.level = super::super::power_curve::PowerCurve::polynomial(vec![-123.0]);
+    let problem = problem(field());
+    let survey = problem.camera.survey(20.0, problem.overlaps).unwrap();
+    let path = plan_path(&problem.polygon, 0, &survey, problem.direction).unwrap();
+    let err = price(survey, path, &negative).unwrap_err();
+    assert!(matches!(err, MissionError::LegEnergy { .. }), "{err}");
+}

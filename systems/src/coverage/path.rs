@@ -43,6 +43,31 @@ pub enum PathError {
     StartVertex { index: usize, len: usize },
     #[error("the sweep found no cell above its base in a sub-area of {vertices} vertices")]
     NoBaseCell { vertices: usize },
+    /// Bounded work: the counts come from the inputs (area size against footprint and
+    /// overlaps), so they are checked before anything is allocated.
+    #[error(
+        "covering the area at {altitude_m:.2} m takes more than {limit} photos and stripes, the \
+         planner's limit: the footprint is {l_x:.3e} m x {l_y:.3e} m, stripes come {d_x:.3e} m \
+         apart and photos along a stripe {d_y:.3e} m apart (a smaller area, less overlap or an \
+         image closer to square needs fewer)"
+    )]
+    TooManyShots {
+        limit: usize,
+        altitude_m: f64,
+        l_x: f64,
+        l_y: f64,
+        d_x: f64,
+        d_y: f64,
+    },
+    #[error(
+        "the area is thinner than the planner's tolerance ({tolerance:.3e} m) yet does not fit \
+         in one footprint ({l_x:.3e} m x {l_y:.3e} m): there is nothing of positive area to sweep"
+    )]
+    TooThin { tolerance: f64, l_x: f64, l_y: f64 },
+    #[error(
+        "the area nests concavities more than {limit} deep; the planner recurses once per level"
+    )]
+    TooDeep { limit: usize },
 }
 
 /// A point of the path; `shot` holds the along-track direction of the image taken there (the
@@ -86,6 +111,15 @@ pub struct CoveragePath {
 /// provably ends (it then walks the parent's finite set of trapezoids).
 const MAX_REORIENT_DEPTH: usize = 16;
 
+/// Most photos plus stripes one path may plan. A survey of 100 km^2 at 2 cm/px takes about
+/// 10^5 photos; the limit bounds the memory and time of one plan (and of every re-plan of the
+/// altitude search) whatever the area, camera and overlaps say.
+pub const MAX_SHOTS: usize = 1_000_000;
+
+/// Deepest nesting of sub-areas cut off at concavities: each level is a recursive call, so the
+/// limit keeps the stack bounded (real fields nest a few levels).
+pub const MAX_AREA_DEPTH: usize = 256;
+
 /// Plans the coverage path of `polygon` for the camera geometry of `survey`, starting and ending
 /// at vertex `start_vertex` (an index into [`Polygon::vertices`]).
 pub fn plan_path(
@@ -112,13 +146,31 @@ pub fn plan_path(
         waypoints: Vec::new(),
         stripes: 0,
         areas: 0,
+        budget: MAX_SHOTS,
     };
     planner.go(start, None);
     // The validated polygon may still hold collinear vertices; they would split edges.
-    if let Some(area) = clean_ring(vertices.to_vec(), eps) {
-        let entry = nearest(&area, start);
-        planner.go(area[entry], None);
-        planner.cover(area, entry, 0, None)?;
+    match clean_ring(vertices.to_vec(), eps) {
+        Some(area) => {
+            let entry = nearest(&area, start);
+            planner.go(area[entry], None);
+            planner.cover(area, entry, 0, None)?;
+        }
+        // Thinner than the tolerance: one shot covers it if one footprint does (whichever way
+        // the image lies), else there is no area to sweep and no honest plan.
+        None => {
+            let l = survey.footprint;
+            if (hi - lo).max_element() > l.l_x.min(l.l_y) {
+                return Err(PathError::TooThin {
+                    tolerance: eps,
+                    l_x: l.l_x,
+                    l_y: l.l_y,
+                });
+            }
+            let longest = longest_edge(vertices);
+            let along = (vertices[(longest + 1) % vertices.len()] - vertices[longest]).normalize();
+            planner.go((lo + hi) / 2.0, Some(along));
+        }
     }
     planner.go(start, None);
     Ok(CoveragePath {
@@ -135,9 +187,35 @@ struct Planner<'a> {
     waypoints: Vec<Waypoint>,
     stripes: usize,
     areas: usize,
+    /// Photos and stripes still allowed ([`MAX_SHOTS`]).
+    budget: usize,
 }
 
 impl Planner<'_> {
+    /// Takes `count` from the budget, checked before the caller allocates or loops `count` times.
+    fn spend(&mut self, count: usize) -> Result<(), PathError> {
+        self.budget = self.budget.checked_sub(count).ok_or_else(|| {
+            let l = self.survey.footprint;
+            PathError::TooManyShots {
+                limit: MAX_SHOTS,
+                altitude_m: self.survey.altitude_m,
+                l_x: l.l_x,
+                l_y: l.l_y,
+                d_x: self.survey.d_x,
+                d_y: self.survey.d_y,
+            }
+        })?;
+        Ok(())
+    }
+
+    /// Shot offsets along a stretch of `length`, paid for from the budget.
+    fn shots_along(&mut self, length: f64) -> Result<Vec<f64>, PathError> {
+        let l_y = self.survey.footprint.l_y;
+        let count = shot_count(length, l_y, self.survey.d_y).unwrap_or(usize::MAX);
+        self.spend(count)?;
+        Ok(shot_offsets(length, l_y, count))
+    }
+
     fn here(&self) -> DVec2 {
         self.waypoints.last().map_or(DVec2::ZERO, |w| w.position)
     }
@@ -164,6 +242,11 @@ impl Planner<'_> {
         depth: usize,
         parent_u: Option<DVec2>,
     ) -> Result<(), PathError> {
+        if depth > MAX_AREA_DEPTH {
+            return Err(PathError::TooDeep {
+                limit: MAX_AREA_DEPTH,
+            });
+        }
         self.areas += 1;
         let l = self.survey.footprint;
         let (sweep, base) = self.sweep(&area, depth, parent_u);
@@ -178,12 +261,16 @@ impl Planner<'_> {
         // An area that fits in one footprint takes one shot at its centre.
         let (lo, hi) = bounds(&sweep.points);
         if hi.x - lo.x <= l.l_y && hi.y - lo.y <= l.l_x {
+            self.spend(1)?;
             self.go(frame.to_world((lo + hi) / 2.0), Some(frame.u));
             self.go(area[entry], None);
             return Ok(());
         }
 
-        let stripes = stripe_levels(&cell, l.l_x, self.survey.d_x);
+        let count =
+            stripe_count(cell.top() - cell.bottom(), l.l_x, self.survey.d_x).unwrap_or(usize::MAX);
+        self.spend(count)?;
+        let stripes = stripe_levels(&cell, l.l_x, count);
         self.stripes += stripes.len();
         let first = cell
             .extent(stripes[0] - l.l_x / 2.0, stripes[0] + l.l_x / 2.0)
@@ -191,7 +278,7 @@ impl Planner<'_> {
 
         // Part 1: along the border to the corner the first stripe starts from.
         let route = self.approach(&area, entry, &base, first);
-        self.border(&area, &route);
+        self.border(&area, &route)?;
         let mut forward = route.forward;
 
         // Part 2: the stripes, with the parts cut off at concavities.
@@ -202,7 +289,7 @@ impl Planner<'_> {
             if let Some((u0, u1)) = cell.extent(band.0, band.1) {
                 let from = if forward { u0 } else { u1 };
                 let along = if forward { frame.u } else { -frame.u };
-                for s in shot_offsets(u1 - u0, l.l_y, self.survey.d_y) {
+                for s in self.shots_along(u1 - u0)? {
                     let u = if forward { from + s } else { from - s };
                     self.go(frame.to_world(DVec2::new(u, level)), Some(along));
                 }
@@ -217,7 +304,7 @@ impl Planner<'_> {
         // Part 3: back along the border to the entry vertex.
         let from = nearest(&area, self.here());
         let route = shorter_route(&area, from, entry);
-        self.border(&area, &route);
+        self.border(&area, &route)?;
         self.go(area[entry], None);
         Ok(())
     }
@@ -280,7 +367,7 @@ impl Planner<'_> {
     }
 
     /// Shots along each border edge of `route` (parts 1 and 3).
-    fn border(&mut self, area: &[DVec2], route: &Route) {
+    fn border(&mut self, area: &[DVec2], route: &Route) -> Result<(), PathError> {
         let n = area.len();
         let l = self.survey.footprint;
         for &(from, to) in &route.edges {
@@ -292,13 +379,14 @@ impl Planner<'_> {
             let grow_a = corner_growth(area, from, to, l.l_x);
             let grow_b = corner_growth(area, to, from, l.l_x);
             let length = a.distance(b) + grow_a + grow_b;
-            for s in shot_offsets(length, l.l_y, self.survey.d_y) {
+            for s in self.shots_along(length)? {
                 self.go(
                     a + along * (s - grow_a) + inward * (l.l_x / 2.0),
                     Some(along),
                 );
             }
         }
+        Ok(())
     }
 
     /// Covers each part cut off beyond `chords`, nearest first, entering each at its vertex
@@ -396,35 +484,60 @@ fn corner_growth(area: &[DVec2], vertex: usize, other: usize, l_x: f64) -> f64 {
     (l_x / turn.tan()).min(adjacent * turn.cos())
 }
 
-/// Offsets of the shots along a stretch of `length`: the first `L_y/2` in, the last `L_y/2`
-/// before its end, `m = ceil(length / d_y)` of them `Delta_y = (length - L_y)/(m - 1)` apart; one
-/// in the middle when a single footprint spans the stretch.
-fn shot_offsets(length: f64, l_y: f64, d_y: f64) -> Vec<f64> {
+/// How many shots a stretch of `length` takes: `m = ceil(length / d_y)`, at least 2, or 1 when a
+/// single footprint spans it; `None` when the count is not a finite number a `usize` holds (the
+/// float is checked before the cast, which would saturate or wrap).
+fn shot_count(length: f64, l_y: f64, d_y: f64) -> Option<usize> {
     if length <= l_y {
-        return vec![length / 2.0];
+        return Some(1);
     }
-    let m = ((length / d_y).ceil() as usize).max(2);
-    let delta = (length - l_y) / (m - 1) as f64;
-    (0..m).map(|i| l_y / 2.0 + delta * i as f64).collect()
+    finite_count((length / d_y).ceil().max(2.0))
 }
 
-/// Levels of the stripes over a cell of height `d_max`: `n_s = ceil(d_max / d_x)` made even, the
-/// first `L_x/2` above the base, the last `L_x/2` below the top, `Delta_x = (d_max - L_x)/(n_s -
-/// 1)` apart. When one footprint spans the cell (`d_max <= L_x`, where that spacing would turn
+/// Offsets of the `count` shots ([`shot_count`]) along a stretch of `length`: the first `L_y/2`
+/// in, the last `L_y/2` before its end, `Delta_y = (length - L_y)/(m - 1)` apart; one in the
+/// middle when a single footprint spans the stretch.
+fn shot_offsets(length: f64, l_y: f64, count: usize) -> Vec<f64> {
+    if count <= 1 || length <= l_y {
+        return vec![length / 2.0];
+    }
+    let delta = (length - l_y) / (count - 1) as f64;
+    (0..count).map(|i| l_y / 2.0 + delta * i as f64).collect()
+}
+
+/// How many stripes a cell of height `d_max` takes: `n_s = ceil(d_max / d_x)`, at least 2, made
+/// even; `None` when that is no finite `usize`.
+fn stripe_count(d_max: f64, l_x: f64, d_x: f64) -> Option<usize> {
+    if d_max <= l_x {
+        return Some(2);
+    }
+    let n_s = (d_max / d_x).ceil().max(2.0);
+    finite_count(n_s + n_s % 2.0)
+}
+
+/// Levels of the `n_s` stripes ([`stripe_count`]) over `cell`, of height `d_max`: the first
+/// `L_x/2` above the base, the last `L_x/2` below the top, `Delta_x = (d_max - L_x)/(n_s - 1)`
+/// apart. When one footprint spans the cell (`d_max <= L_x`, where that spacing would turn
 /// negative) the two stripes of the smallest even count both run through its middle, out and
 /// back.
-fn stripe_levels(cell: &Cell, l_x: f64, d_x: f64) -> Vec<f64> {
+fn stripe_levels(cell: &Cell, l_x: f64, n_s: usize) -> Vec<f64> {
     let (bottom, top) = (cell.bottom(), cell.top());
     let d_max = top - bottom;
-    if d_max <= l_x {
+    if d_max <= l_x || n_s < 2 {
         return vec![bottom + d_max / 2.0; 2];
     }
-    let mut n_s = ((d_max / d_x).ceil() as usize).max(2);
-    n_s += n_s % 2;
     let delta = (d_max - l_x) / (n_s - 1) as f64;
     (0..n_s)
         .map(|k| bottom + l_x / 2.0 + delta * k as f64)
         .collect()
+}
+
+/// `x` as a count when it is finite and below `usize::MAX` (NaN and infinity are not).
+fn finite_count(x: f64) -> Option<usize> {
+    // 2^53 is far above any budget and exactly representable, so the cast below is exact.
+    (0.0..=9_007_199_254_740_992.0)
+        .contains(&x)
+        .then_some(x as usize)
 }
 
 fn nearest(points: &[DVec2], p: DVec2) -> usize {

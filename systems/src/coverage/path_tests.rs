@@ -1,7 +1,7 @@
 //! Coverage tests of the planner: every point of the polygon lies in the footprint of a shot.
 
 use super::camera::{Camera, Overlaps, SurveyGeometry};
-use super::path::{CoveragePath, ScanDirection, plan_path};
+use super::path::{CoveragePath, MAX_SHOTS, PathError, ScanDirection, plan_path};
 use super::polygon::Polygon;
 use glam::DVec2;
 use proptest::prelude::*;
@@ -332,4 +332,86 @@ proptest! {
             }
         }
     }
+}
+
+fn rectangle_160_by_100() -> Polygon {
+    polygon(&[(0.0, 0.0), (160.0, 0.0), (160.0, 100.0), (0.0, 100.0)])
+}
+
+fn too_many_shots(survey: &SurveyGeometry, area: &Polygon) -> bool {
+    matches!(
+        plan_path(area, 0, survey, ScanDirection::LongestEdge),
+        Err(PathError::TooManyShots {
+            limit: MAX_SHOTS,
+            ..
+        })
+    )
+}
+
+#[test]
+fn overlap_next_to_one_is_refused_before_allocating() {
+    // d_y = 15 m * 1e-9: 1e10 photos a stripe (64 GB of offsets before the limit).
+    let survey = Camera {
+        angle_of_view: PI / 2.0,
+        width_px: 4000,
+        height_px: 3000,
+        shot_period_s: 1.0,
+    }
+    .survey(
+        10.0,
+        Overlaps {
+            x: 0.2,
+            y: 0.999999999,
+        },
+    )
+    .unwrap();
+    assert!(too_many_shots(&survey, &rectangle_160_by_100()));
+}
+
+#[test]
+fn a_sliver_image_is_refused_before_allocating() {
+    // 4294967295 x 1 px: L_y = L_x / 4.3e9, photos 3.7e-9 m apart.
+    let survey = Camera {
+        angle_of_view: 1.2,
+        width_px: u32::MAX,
+        height_px: 1,
+        shot_period_s: 1.0,
+    }
+    .survey(120.0, Overlaps { x: 0.2, y: 0.3 })
+    .unwrap();
+    let err = plan_path(
+        &rectangle_160_by_100(),
+        0,
+        &survey,
+        ScanDirection::LongestEdge,
+    )
+    .unwrap_err();
+    assert!(err.to_string().contains("the planner's limit"), "{err}");
+}
+
+#[test]
+fn a_huge_area_is_refused_not_a_panic() {
+    // 10^7 m square at 16 m between stripes and 10.5 m between photos: 6e11 photos. The stripe
+    // count once overflowed into an empty stripe list and an index panic.
+    let side = 1e7;
+    let area = polygon(&[(0.0, 0.0), (side, 0.0), (side, side), (0.0, side)]);
+    assert!(too_many_shots(&survey(), &area));
+    // Just inside the limit is planned.
+    let area = polygon(&[(0.0, 0.0), (1000.0, 0.0), (1000.0, 1000.0), (0.0, 1000.0)]);
+    let path = plan_path(&area, 0, &survey(), ScanDirection::LongestEdge).unwrap();
+    assert!(path.shots().count() < MAX_SHOTS);
+}
+
+#[test]
+fn an_area_thinner_than_the_tolerance_is_an_error_or_one_shot() {
+    // 100 m long and 1e-9 m wide: no sweep, and more than one footprint long.
+    let sliver = polygon(&[(0.0, 0.0), (100.0, 0.0), (100.0, 1e-9), (0.0, 1e-9)]);
+    let err = plan_path(&sliver, 0, &survey(), ScanDirection::LongestEdge).unwrap_err();
+    assert!(matches!(err, PathError::TooThin { .. }), "{err}");
+    // A speck inside one footprint: one photo on it, not none.
+    let speck = polygon(&[(5.0, 5.0), (5.0 + 1e-9, 5.0), (5.0, 5.0 + 1e-9)]);
+    let path = plan_path(&speck, 0, &survey(), ScanDirection::LongestEdge).unwrap();
+    let shots: Vec<_> = path.shots().collect();
+    assert_eq!(shots.len(), 1);
+    assert!(shots[0].0.distance(DVec2::new(5.0, 5.0)) < 1e-6);
 }

@@ -15,6 +15,18 @@ pub enum PolygonError {
     TooFewVertices(usize),
     #[error("vertex {index} has a non-finite coordinate ({x}, {y})")]
     NonFinite { index: usize, x: f64, y: f64 },
+    #[error(
+        "vertex {index} at ({x:?}, {y:?}) lies beyond {limit:e} m of the origin: a field is planned \
+         in a local plane in metres"
+    )]
+    TooFar {
+        index: usize,
+        x: f64,
+        y: f64,
+        limit: f64,
+    },
+    #[error("a field may have at most {limit} vertices, got {count}")]
+    TooManyVertices { count: usize, limit: usize },
     #[error("vertices {first} and {second} coincide at ({x}, {y}): zero-length edge")]
     RepeatedVertex {
         first: usize,
@@ -36,6 +48,15 @@ pub enum PolygonError {
     },
 }
 
+/// Largest coordinate accepted (m). UTM northings reach 10^7 m, so projected fields fit; beyond
+/// 10^8 m a field is no local plane, and spans, areas and the planner's tolerances would lose
+/// their meaning (or overflow).
+pub const MAX_COORDINATE_M: f64 = 1e8;
+
+/// Most vertices of a field: the simplicity check is quadratic in them and the planner's
+/// sub-areas grow with them.
+pub const MAX_VERTICES: usize = 10_000;
+
 /// A validated simple polygon, stored counter-clockwise (interior on the left of every edge).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Polygon {
@@ -49,12 +70,26 @@ impl Polygon {
     /// dropped) and orients them counter-clockwise.
     pub fn new(vertices: Vec<DVec2>) -> Result<Self, PolygonError> {
         let mut vertices = vertices;
+        if vertices.len() > MAX_VERTICES {
+            return Err(PolygonError::TooManyVertices {
+                count: vertices.len(),
+                limit: MAX_VERTICES,
+            });
+        }
         for (index, v) in vertices.iter().enumerate() {
             if !v.is_finite() {
                 return Err(PolygonError::NonFinite {
                     index,
                     x: v.x,
                     y: v.y,
+                });
+            }
+            if v.abs().max_element() > MAX_COORDINATE_M {
+                return Err(PolygonError::TooFar {
+                    index,
+                    x: v.x,
+                    y: v.y,
+                    limit: MAX_COORDINATE_M,
                 });
             }
         }
@@ -308,6 +343,25 @@ mod tests {
         assert!(matches!(
             poly(&[(0.0, 0.0), (f64::NAN, 0.0), (0.0, 1.0)]),
             Err(PolygonError::NonFinite { index: 1, .. })
+        ));
+    }
+
+    #[test]
+    fn far_away_and_oversized_fields_are_refused() {
+        // 1e30 m once overflowed the planner's stripe count into an index panic.
+        let err = poly(&[(0.0, 0.0), (1e30, 0.0), (1e30, 1e30), (0.0, 1e30)]).unwrap_err();
+        assert!(
+            matches!(err, PolygonError::TooFar { index: 1, .. }),
+            "{err}"
+        );
+        // UTM-sized coordinates are fine.
+        assert!(poly(&[(5e5, 9.9e6), (5e5 + 10.0, 9.9e6), (5e5, 9.9e6 + 10.0)]).is_ok());
+        let many: Vec<DVec2> = (0..=MAX_VERTICES)
+            .map(|i| DVec2::from_angle(i as f64 * 1e-4))
+            .collect();
+        assert!(matches!(
+            Polygon::new(many),
+            Err(PolygonError::TooManyVertices { .. })
         ));
     }
 

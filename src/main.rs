@@ -4,7 +4,8 @@ use clap::{Parser, Subcommand};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
-use uavex_engine::run::{RunOptions, load_and_check, run_file};
+use uavex_components::sim::Outcome;
+use uavex_engine::run::{RunOptions, load_and_check};
 
 #[derive(Parser)]
 #[command(
@@ -52,8 +53,8 @@ enum Command {
         /// The results folder.
         #[arg(long)]
         out: PathBuf,
-        /// Runs at once (default: one per core).
-        #[arg(long)]
+        /// Runs at once, 1 to 1024 (default: one per core); never more than the runs to start.
+        #[arg(long, value_parser = jobs)]
         jobs: Option<usize>,
         /// Run only part i of N of the plan (1 <= i <= N), e.g. 2/4.
         #[arg(long)]
@@ -132,18 +133,54 @@ fn parse_override(text: &str) -> Result<(String, f64), String> {
 /// Exit code for a scenario that cannot be run as written.
 const INVALID_INPUT: u8 = 2;
 
-/// A wall-clock limit in seconds: positive and finite.
+/// A wall-clock limit in seconds: positive, finite and within a `Duration` (about 5.8e11
+/// years; `Duration::from_secs_f64` panics beyond).
 fn wall_limit(text: &str) -> Result<Duration, String> {
     let seconds: f64 = text
         .parse()
         .map_err(|_| format!("expected a number of seconds, got {text:?}"))?;
-    if seconds.is_finite() && seconds > 0.0 {
-        Ok(Duration::from_secs_f64(seconds))
-    } else {
-        Err(format!(
-            "expected a positive number of seconds, got {seconds}"
-        ))
+    let limit = Duration::try_from_secs_f64(seconds).ok();
+    limit.filter(|l| !l.is_zero()).ok_or_else(|| {
+        format!(
+            "expected a positive number of seconds up to {:e}, got {text}",
+            Duration::MAX.as_secs_f64()
+        )
+    })
+}
+
+/// `uavex sweep --jobs`: 1 to [`MAX_JOBS`](uavex_engine::sweep::execute::MAX_JOBS). Zero is
+/// refused rather than read as "all cores": that is what leaving `--jobs` out means, and a
+/// zero from a script (an unset CPU count) is more likely a mistake than a wish.
+fn jobs(text: &str) -> Result<usize, String> {
+    use uavex_engine::sweep::execute::MAX_JOBS;
+    match text.parse::<usize>() {
+        Ok(jobs) if (1..=MAX_JOBS).contains(&jobs) => Ok(jobs),
+        _ => Err(format!(
+            "expected a number of runs at once from 1 to {MAX_JOBS}, got {text:?} \
+             (leave --jobs out for one per core)"
+        )),
     }
+}
+
+/// Makes sure run results can be written into `dir` before the run, not after it: creates
+/// the folder and writes and removes a file in it.
+fn check_out_dir(dir: &std::path::Path) -> Result<(), String> {
+    let cannot =
+        |e: std::io::Error| format!("--out {}: cannot write results there: {e}", dir.display());
+    std::fs::create_dir_all(dir).map_err(cannot)?;
+    let probe = dir.join(format!(".uavex-write-check-{}", std::process::id()));
+    std::fs::write(&probe, b"").map_err(cannot)?;
+    std::fs::remove_file(&probe).map_err(cannot)
+}
+
+/// True when `dir/summary.json` is the summary of this run. The run writes it last and, when
+/// writing fails, reports that in the returned summary's reason instead; a summary left by an
+/// earlier run never has that reason, so an equal reason means the file is this run's.
+fn summary_written(dir: &std::path::Path, summary: &uavex_engine::output::RunSummary) -> bool {
+    std::fs::read_to_string(dir.join(uavex_engine::sweep::execute::SUMMARY_FILE))
+        .ok()
+        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
+        .is_some_and(|written| written["reason"] == summary.reason.as_str())
 }
 
 fn main() -> ExitCode {
@@ -159,7 +196,7 @@ fn main() -> ExitCode {
         } => {
             let mut options = uavex_engine::sweep::SweepOptions::new(out);
             if let Some(jobs) = jobs {
-                options.jobs = jobs.max(1);
+                options.jobs = jobs;
             }
             options.shard = shard;
             options.max_runs = max_runs;
@@ -205,13 +242,26 @@ fn main() -> ExitCode {
                 eprintln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
                 return ExitCode::from(INVALID_INPUT);
             }
+            let loaded = match uavex_engine::scenario::load(&scenario) {
+                Ok(loaded) => loaded,
+                Err(errors) => {
+                    eprintln!("{errors}");
+                    return ExitCode::from(INVALID_INPUT);
+                }
+            };
+            if let Some(dir) = &out
+                && let Err(e) = check_out_dir(dir)
+            {
+                eprintln!("{e}");
+                return ExitCode::from(INVALID_INPUT);
+            }
             let options = RunOptions {
                 out_dir: out,
                 seed,
                 record,
                 wall_limit,
             };
-            match run_file(&scenario, &options) {
+            match uavex_engine::run::run(&loaded, &options) {
                 Err(errors) => {
                     eprintln!("{errors}");
                     ExitCode::from(INVALID_INPUT)
@@ -229,12 +279,24 @@ fn main() -> ExitCode {
                             .map_or("n/a".to_owned(), |a| format!("{:.2} %", a * 100.0)),
                     );
                     if let Some(out) = &options.out_dir {
+                        // Checked before the run, but a disk can fill up during one.
+                        if !summary_written(out, &summary) {
+                            eprintln!("no results written to {}", out.display());
+                            return ExitCode::FAILURE;
+                        }
                         println!("results in {}", out.display());
                     }
                     if let Some(file) = options.record.as_ref().filter(|f| f.exists()) {
                         println!("recording in {} (view it with `rerun {0}`)", file.display());
                     }
-                    ExitCode::SUCCESS
+                    // A crash or an empty battery is a result of the study; `failed` (a panic,
+                    // the wall-clock limit, a flight that diverged) means there is none, which
+                    // a script running uavex must be able to tell.
+                    if summary.outcome == Outcome::Failed {
+                        ExitCode::FAILURE
+                    } else {
+                        ExitCode::SUCCESS
+                    }
                 }
             }
         }
@@ -246,6 +308,7 @@ fn sweep_command(
     plan_path: &std::path::Path,
     options: uavex_engine::sweep::SweepOptions,
 ) -> ExitCode {
+    use uavex_engine::sweep::execute::reason_excerpt;
     use uavex_engine::sweep::{Plan, run_sweep};
     let plan = match Plan::load(plan_path) {
         Ok(plan) => plan,
@@ -272,7 +335,7 @@ fn sweep_command(
         report.already_done,
         report.ran,
         started.elapsed().as_secs_f64(),
-        options.jobs,
+        report.jobs,
         report.failed.len(),
         if report.not_started > 0 {
             format!(", {} left for later", report.not_started)
@@ -281,10 +344,7 @@ fn sweep_command(
         },
     );
     for (id, reason) in &report.failed {
-        println!(
-            "  failed {id}: {}",
-            reason.lines().next().unwrap_or_default()
-        );
+        println!("  failed {id}: {}", reason_excerpt(reason, "    "));
     }
     write_results(&options.out_dir)
 }
@@ -295,7 +355,10 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
         Ok(report) => report,
         Err(e) => {
             eprintln!("merge: {e}");
-            return ExitCode::FAILURE;
+            return match e {
+                uavex_engine::sweep::SweepError::NotResults(_) => ExitCode::from(INVALID_INPUT),
+                _ => ExitCode::FAILURE,
+            };
         }
     };
     println!(
@@ -349,7 +412,10 @@ fn write_plots(dir: &std::path::Path) -> ExitCode {
         }
         Err(e) => {
             eprintln!("cannot plot {}: {e}", dir.display());
-            ExitCode::FAILURE
+            match e {
+                uavex_engine::plot::PlotError::NotResults(_) => ExitCode::from(INVALID_INPUT),
+                _ => ExitCode::FAILURE,
+            }
         }
     }
 }

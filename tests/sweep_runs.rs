@@ -284,3 +284,28 @@ fn the_command_line_runs_shards_merges_and_plots() {
     let (code, _) = uavex(&["sweep", "plan.toml", "--out", "x", "--shard", "3/2"]);
     assert_eq!(code, Some(2), "clap refuses a shard out of range");
 }
+
+/// A run's folder is named after its scene; scenes named like hidden or parent folders still
+/// give runs that the tables, the plots and a merge see.
+#[test]
+fn scenes_named_like_hidden_or_parent_folders_are_in_the_tables() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plan = plan_text_in(
+        tmp.path(),
+        "seeds = 1\n\
+         [[scenario]]\nfile = \"room.toml\"\nname = \".hidden\"\n\
+         [[scenario]]\nfile = \"room.toml\"\nname = \"../x\"\n",
+    );
+    let out = tmp.path().join("out");
+    let report = sweep(&plan, &out, 2);
+    assert_eq!((report.ran, report.failed.len()), (2, 0));
+    assert_eq!(write_tables(&out).unwrap(), 2);
+    let runs_csv = std::fs::read_to_string(out.join("runs.csv")).unwrap();
+    assert!(
+        runs_csv.contains(",.hidden,") && runs_csv.contains(",../x,"),
+        "{runs_csv}"
+    );
+    assert!(!tmp.path().join("x").exists(), "no run outside the folder");
+    let merged = uavex::engine::sweep::merge(&tmp.path().join("merged"), &[out]).unwrap();
+    assert_eq!((merged.copied, merged.missing.len()), (2, 0));
+}

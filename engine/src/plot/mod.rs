@@ -10,7 +10,7 @@
 pub mod draw;
 pub mod series;
 
-use crate::tables::results::{RunRow, read_results};
+use crate::tables::results::{RunRow, group_by, read_results};
 use crate::tables::{Cell, TablesError};
 use draw::{BandFigure, BandPanel, StripFigure, StripPanel, save};
 use series::{band, read_curve};
@@ -114,6 +114,8 @@ pub const PLOTS_DIR: &str = "plots";
 pub enum PlotError {
     #[error(transparent)]
     Results(#[from] TablesError),
+    #[error(transparent)]
+    NotResults(#[from] crate::sweep::execute::NotResultsFolder),
     #[error("{path}: {source}")]
     Io {
         path: PathBuf,
@@ -127,10 +129,9 @@ pub enum PlotError {
 
 /// The groups of a scene in plan order: (label, rows), failed runs left out.
 fn scene_groups<'a>(rows: &'a [RunRow], scene: &str) -> Vec<(String, Vec<&'a RunRow>)> {
-    let mut groups: Vec<(String, Vec<&RunRow>)> = Vec::new();
-    for row in rows.iter().filter(|r| r.run.scene == scene && !r.failed()) {
+    let label = |row: &&RunRow| {
         let (_, coordinates) = row.group_key();
-        let label = if coordinates.is_empty() {
+        if coordinates.is_empty() {
             "all runs".to_owned()
         } else {
             coordinates
@@ -138,13 +139,12 @@ fn scene_groups<'a>(rows: &'a [RunRow], scene: &str) -> Vec<(String, Vec<&'a Run
                 .map(|(_, v)| v.as_str())
                 .collect::<Vec<_>>()
                 .join(", ")
-        };
-        match groups.iter_mut().find(|(l, _)| *l == label) {
-            Some((_, members)) => members.push(row),
-            None => groups.push((label, vec![row])),
         }
-    }
-    groups
+    };
+    group_by(
+        rows.iter().filter(|r| r.run.scene == scene && !r.failed()),
+        label,
+    )
 }
 
 fn scenes(rows: &[RunRow]) -> Vec<String> {
@@ -158,7 +158,9 @@ fn scenes(rows: &[RunRow]) -> Vec<String> {
 }
 
 /// Draws every plot of the results folder `dir` into `dir/plots`; returns the files written.
+/// Refuses a folder no sweep wrote rather than create `plots/` in it.
 pub fn plot_dir(dir: &Path) -> Result<Vec<PathBuf>, PlotError> {
+    crate::sweep::execute::check_results_folder(dir)?;
     let rows = read_results(dir)?;
     let out = dir.join(PLOTS_DIR);
     std::fs::create_dir_all(&out).map_err(|source| PlotError::Io {

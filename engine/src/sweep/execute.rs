@@ -37,12 +37,18 @@ pub const RUN_FILE: &str = "run.json";
 pub const RUNS_DIR: &str = "runs";
 /// The plan's copy in a results folder.
 pub const PLAN_FILE: &str = "plan.toml";
+/// Most runs at once `uavex sweep --jobs` accepts. A worker is a thread of the pool, and
+/// thousands of them only cost time to start (10000 took over a minute for 2 runs).
+pub const MAX_JOBS: usize = 1024;
+/// Lines of a failed run's reason that the console shows (a refused scenario's diagnostics);
+/// the whole reason is in the run's `summary.json`.
+pub const REASON_LINES: usize = 6;
 
 /// How to run a plan.
 #[derive(Debug, Clone)]
 pub struct SweepOptions {
     pub out_dir: PathBuf,
-    /// Runs at once (threads of the pool); at least 1.
+    /// Runs at once (threads of the pool); at least 1, and never more than the runs to start.
     pub jobs: usize,
     /// Run only this part of the plan.
     pub shard: Option<Shard>,
@@ -83,6 +89,8 @@ pub struct SweepReport {
     pub failed: Vec<(String, String)>,
     /// Runs left for later by `max_runs`.
     pub not_started: usize,
+    /// Runs that ran at once: the jobs asked for, but no more than the runs to start.
+    pub jobs: usize,
 }
 
 /// A sweep that cannot start or whose results cannot be written at all.
@@ -99,6 +107,54 @@ pub enum SweepError {
     PlansDiffer(PathBuf, PathBuf),
     #[error(transparent)]
     Plan(#[from] super::plan::PlanError),
+    #[error(transparent)]
+    NotResults(#[from] NotResultsFolder),
+}
+
+/// A folder given as a results folder (to merge or plot) that no sweep wrote.
+#[derive(Debug, Error)]
+#[error("{path} is not a results folder of `uavex sweep`: {why}")]
+pub struct NotResultsFolder {
+    pub path: PathBuf,
+    pub why: &'static str,
+}
+
+/// Accepts a folder a sweep (or a merge) wrote: it holds `runs/` or `plan.toml`. Reading a
+/// misspelt folder as one with no runs would give empty tables and a success.
+pub fn check_results_folder(dir: &Path) -> Result<(), NotResultsFolder> {
+    let why = if !dir.exists() {
+        "there is no such folder"
+    } else if !dir.is_dir() {
+        "it is not a folder"
+    } else if !dir.join(RUNS_DIR).is_dir() && !dir.join(PLAN_FILE).is_file() {
+        "it holds neither a runs/ folder nor a plan.toml"
+    } else {
+        return Ok(());
+    };
+    Err(NotResultsFolder {
+        path: dir.to_owned(),
+        why,
+    })
+}
+
+/// The first [`REASON_LINES`] lines of a failed run's reason, the later ones indented by
+/// `indent`, and how many more there are.
+pub fn reason_excerpt(reason: &str, indent: &str) -> String {
+    let lines: Vec<&str> = reason.trim_end().lines().collect();
+    let mut text = lines
+        .iter()
+        .take(REASON_LINES)
+        .copied()
+        .collect::<Vec<_>>()
+        .join(&format!("\n{indent}"));
+    if lines.len() > REASON_LINES {
+        let more = lines.len() - REASON_LINES;
+        text.push_str(&format!(
+            "\n{indent}({more} more line{} in its {SUMMARY_FILE})",
+            if more == 1 { "" } else { "s" }
+        ));
+    }
+    text
 }
 
 pub(super) fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> SweepError + '_ {
@@ -150,6 +206,12 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
     if todo.is_empty() {
         return Ok(report);
     }
+    // No more runs at once than runs to start. The pool may keep more threads, up to the
+    // cores, for the runs' own parallel parts; threads beyond both would only idle, and
+    // thousands of them take long to start.
+    report.jobs = options.jobs.clamp(1, todo.len());
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let threads = report.jobs.max(options.jobs.min(cores));
 
     // Each scenario file is read once; a file that cannot be read fails its runs.
     let texts: BTreeMap<&Path, Result<String, String>> = todo
@@ -168,13 +230,14 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
     let bar = progress_bar(todo.len(), options.progress);
     let failed = Mutex::new(Vec::new());
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(options.jobs.max(1))
+        .num_threads(threads)
         .build()
         .map_err(|e| SweepError::Pool(e.to_string()))?;
-    // Runs that differ only in their seed form a group (see `schedule`).
-    let groups: Vec<_> = todo
+    // Runs that differ only in their seed form a group (see `schedule`): plan order lists a
+    // group's seeds one after another, so its number is the plan index over the seed count.
+    let groups: Vec<usize> = todo
         .iter()
-        .map(|run| (&run.scenario_file, &run.coordinates))
+        .map(|run| run.index / plan.seeds.len().max(1))
         .collect();
     let queue = Mutex::new(RunQueue::new(&groups));
     let take = || lock(&queue).take();
@@ -189,8 +252,11 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
             let ending = execute_run(run, text, &dir, options.run_wall_limit);
             lock(&queue).finished(next, started.elapsed());
             if let Err(reason) = &ending {
-                let first_line = reason.lines().next().unwrap_or_default();
-                bar.println(format!("run {} failed: {first_line}", run.id));
+                bar.println(format!(
+                    "run {} failed: {}",
+                    run.id,
+                    reason_excerpt(reason, "    ")
+                ));
                 let mut failed = lock(&failed);
                 failed.push((run.index, run.id.clone(), reason.clone()));
                 bar.set_message(format!("{} failed", failed.len()));
@@ -319,4 +385,20 @@ fn progress_bar(len: usize, show: bool) -> ProgressBar {
     bar.set_message("0 failed");
     bar.enable_steady_tick(Duration::from_millis(500));
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reason_is_shown_up_to_its_sixth_line() {
+        assert_eq!(reason_excerpt("one line\n", "  "), "one line");
+        let long: String = (1..=9).map(|i| format!("line {i}\n")).collect();
+        assert_eq!(
+            reason_excerpt(&long, "  "),
+            "line 1\n  line 2\n  line 3\n  line 4\n  line 5\n  line 6\n  \
+             (3 more lines in its summary.json)"
+        );
+    }
 }

@@ -139,7 +139,11 @@ pub fn run_id(
     coordinates: &[(String, toml::Value)],
     seed: u64,
 ) -> String {
-    let mut readable = slug(scene);
+    // Folders whose name starts with a dot are not runs (hidden files, merge's `.ID.partial`
+    // copies), so a scene named `.hidden` or `../x` must not start its id with one.
+    let mut readable: String = slug(scene);
+    let dots = readable.len() - readable.trim_start_matches('.').len();
+    readable.replace_range(..dots, &"_".repeat(dots));
     for (path, value) in coordinates {
         let key = path.rsplit('.').find(|k| k.parse::<usize>().is_err());
         let value = match value {
@@ -317,6 +321,21 @@ mod tests {
         let other = PLAN.replace("time_limit_s = 3.0", "time_limit_s = 4.0");
         let other_ids: BTreeSet<String> = expand(&plan(&other)).into_iter().map(|r| r.id).collect();
         assert!(ids.iter().all(|id| !other_ids.contains(*id)));
+    }
+
+    #[test]
+    fn ids_never_start_with_a_dot() {
+        let set = [];
+        let id = |scene: &str| run_id(scene, &set, &[], 1);
+        assert!(
+            id(".hidden").starts_with("_hidden__seed=1__"),
+            "{}",
+            id(".hidden")
+        );
+        assert!(id("../x").starts_with("___x__seed=1__"), "{}", id("../x"));
+        assert!(id("a.b").starts_with("a.b__seed=1__"), "{}", id("a.b"));
+        // The hash keeps the scene as written: `.hidden` and `_hidden` are two runs.
+        assert_ne!(id(".hidden"), id("_hidden"));
     }
 
     #[test]

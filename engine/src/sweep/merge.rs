@@ -5,7 +5,9 @@
 //! two folders is kept once; if its deterministic results differ between them, that is
 //! reported as a conflict. Runs of the plan present in no folder are reported as missing.
 
-use super::execute::{PLAN_FILE, RUNS_DIR, SUMMARY_FILE, SweepError, io_error, is_finished};
+use super::execute::{
+    PLAN_FILE, RUNS_DIR, SUMMARY_FILE, SweepError, check_results_folder, io_error, is_finished,
+};
 use super::expand::expand;
 use super::plan::Plan;
 use crate::output::{HOST_FIELDS, write_atomically};
@@ -24,8 +26,12 @@ pub struct MergeReport {
     pub missing: Vec<String>,
 }
 
-/// Merges the finished runs of `shards` into `out` (which may be one of them).
+/// Merges the finished runs of `shards` into `out` (which may be one of them). Every shard
+/// must be a results folder: a misspelt one would otherwise merge as a shard with no runs.
 pub fn merge(out: &Path, shards: &[PathBuf]) -> Result<MergeReport, SweepError> {
+    for shard in shards {
+        check_results_folder(shard)?;
+    }
     let plan_text = common_plan(out, shards)?;
     let runs_out = out.join(RUNS_DIR);
     std::fs::create_dir_all(&runs_out).map_err(io_error(&runs_out))?;

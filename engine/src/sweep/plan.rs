@@ -28,6 +28,12 @@ use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
+/// Most runs a plan may have. A sweep expands its plan into runs before starting any (their
+/// ids say which are finished): a million runs of two grid paths took 1.2 GB and 11 s before
+/// the first run started (2026-12-05, release build), and a million runs of even a second each
+/// are eleven days of one core. A bigger plan is a mistake, or several plans.
+pub const MAX_RUNS: usize = 1_000_000;
+
 /// A plan that parsed and makes sense.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Plan {
@@ -195,6 +201,8 @@ impl Plan {
             }
         }
 
+        check_size(scenarios.len(), &grid, seeds.len()).map_err(invalid)?;
+
         let base_dir = match path.parent() {
             Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
             _ => PathBuf::from("."),
@@ -218,6 +226,32 @@ impl Plan {
     }
 }
 
+/// Refuses a plan of more than [`MAX_RUNS`] runs, naming what multiplies up to its size (the
+/// count saturates: 20 axes of 100 values overflow any integer).
+fn check_size(scenarios: usize, grid: &[Axis], seeds: usize) -> Result<(), String> {
+    let plural = |n: usize, what: &str| format!("{n} {what}{}", if n == 1 { "" } else { "s" });
+    let mut factors = vec![plural(scenarios, "scenario")];
+    factors.extend(
+        grid.iter()
+            .map(|axis| format!("{} of `{}`", plural(axis.values.len(), "value"), axis.path)),
+    );
+    factors.push(plural(seeds, "seed"));
+    let count = grid
+        .iter()
+        .map(|axis| axis.values.len())
+        .chain([scenarios, seeds])
+        .try_fold(1usize, usize::checked_mul);
+    match count {
+        Some(count) if count <= MAX_RUNS => Ok(()),
+        _ => Err(format!(
+            "the plan has {} runs ({}), more than the {MAX_RUNS} a plan may have: \
+             use fewer seeds or grid values, or split it into several plans",
+            count.map_or_else(|| format!("more than {}", usize::MAX), |c| c.to_string()),
+            factors.join(" x "),
+        )),
+    }
+}
+
 /// `seeds = N` (seeds 0..N) or `seeds = [..]` (distinct, non-negative).
 fn seeds(value: Option<toml::Value>) -> Result<Vec<u64>, String> {
     let expected = "`seeds` must be a count (seeds = 5 runs seeds 0 to 4) or a list of seeds";
@@ -229,7 +263,16 @@ fn seeds(value: Option<toml::Value>) -> Result<Vec<u64>, String> {
     let list = match value {
         None => return Err(format!("the plan has no seeds: {expected}")),
         Some(toml::Value::Array(items)) => items.iter().map(seed).collect::<Result<Vec<_>, _>>()?,
-        Some(count @ toml::Value::Integer(_)) => (0..seed(&count)?).collect(),
+        Some(count @ toml::Value::Integer(_)) => {
+            // Checked before the list is made: `seeds = 1000000000` would take 8 GB.
+            let count = seed(&count)?;
+            if count > MAX_RUNS as u64 {
+                return Err(format!(
+                    "`seeds = {count}` is more runs than a plan may have ({MAX_RUNS})"
+                ));
+            }
+            (0..count).collect()
+        }
         Some(other) => return Err(format!("{expected}, not {other}")),
     };
     if list.is_empty() {
@@ -369,6 +412,51 @@ mod tests {
                 "{text:?}: {error}"
             );
         }
+    }
+
+    /// A grid of `axes` paths of `values` values each.
+    fn grid(axes: usize, values: usize) -> String {
+        let list: Vec<String> = (0..values).map(|v| v.to_string()).collect();
+        (0..axes)
+            .map(|a| format!("\"x{a}\" = [{}]\n", list.join(", ")))
+            .collect()
+    }
+
+    #[test]
+    fn plans_beyond_the_run_limit_are_refused_before_they_are_expanded() {
+        // Seeds first: the list itself would be 8 GB.
+        let error = parse("seeds = 1000000000\n[[scenario]]\nfile = \"a.toml\"").unwrap_err();
+        assert!(
+            error.contains("`seeds = 1000000000` is more runs than a plan may have (1000000)"),
+            "{error}"
+        );
+        let error = parse(&format!(
+            "seeds = 2\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n{}",
+            grid(4, 100)
+        ))
+        .unwrap_err();
+        assert!(
+            error.starts_with(
+                "plans/speeds.toml: the plan has 200000000 runs (1 scenario x \
+                               100 values of `x0` x 100 values of `x1` x 100 values of `x2` x \
+                               100 values of `x3` x 2 seeds), more than the 1000000"
+            ),
+            "{error}"
+        );
+        // A count beyond any integer is still refused, not wrapped around.
+        let error = parse(&format!(
+            "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n{}",
+            grid(12, 100)
+        ))
+        .unwrap_err();
+        assert!(error.contains("the plan has more than "), "{error}");
+        // The limit itself is allowed.
+        let plan = parse(&format!(
+            "seeds = 100\n[[scenario]]\nfile = \"a.toml\"\n[grid]\n{}",
+            grid(2, 100)
+        ))
+        .unwrap();
+        assert_eq!(plan.run_count(), MAX_RUNS);
     }
 
     #[test]

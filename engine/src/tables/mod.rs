@@ -34,6 +34,8 @@ pub enum TablesError {
     },
     #[error("{0}")]
     Read(String),
+    #[error(transparent)]
+    NotResults(#[from] crate::sweep::execute::NotResultsFolder),
     #[error("cannot write CSV: {0}")]
     Csv(#[from] csv::Error),
     #[error("cannot write Parquet: {0}")]
@@ -41,7 +43,9 @@ pub enum TablesError {
 }
 
 /// Writes the four tables of the results folder `dir`; returns how many runs they hold.
+/// Refuses a folder no sweep wrote rather than write empty tables into it.
 pub fn write_tables(dir: &Path) -> Result<usize, TablesError> {
+    crate::sweep::execute::check_results_folder(dir)?;
     let rows = read_results(dir)?;
     let table = runs_table(&rows);
     let summary = summarise(&rows);

@@ -36,6 +36,26 @@ impl RunRow {
     }
 }
 
+/// `items` grouped by `key`: groups in order of first appearance, members in their order. A
+/// map finds a key's group, not a search of the groups seen so far, which would be quadratic
+/// in a sweep of many groups (a million single-seed combinations: 10^12 comparisons).
+pub fn group_by<T, K: Ord + Clone>(
+    items: impl IntoIterator<Item = T>,
+    key: impl Fn(&T) -> K,
+) -> Vec<(K, Vec<T>)> {
+    let mut number = std::collections::BTreeMap::new();
+    let mut groups: Vec<(K, Vec<T>)> = Vec::new();
+    for item in items {
+        let k = key(&item);
+        let g = *number.entry(k.clone()).or_insert(groups.len());
+        if g == groups.len() {
+            groups.push((k, Vec::new()));
+        }
+        groups[g].1.push(item);
+    }
+    groups
+}
+
 /// A grid value as a person reads it: strings without quotes, the rest as JSON.
 pub fn value_text(value: &serde_json::Value) -> String {
     match value {
@@ -70,4 +90,23 @@ pub fn read_results(dir: &Path) -> Result<Vec<RunRow>, TablesError> {
     }
     rows.sort_by(|a, b| (a.run.index, &a.run.id).cmp(&(b.run.index, &b.run.id)));
     Ok(rows)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn groups_come_in_order_of_first_appearance() {
+        let groups = group_by(["b1", "a1", "b2", "c1", "a2"], |s| s[..1].to_owned());
+        let got: Vec<(String, Vec<&str>)> = groups;
+        assert_eq!(
+            got,
+            [
+                ("b".to_owned(), vec!["b1", "b2"]),
+                ("a".to_owned(), vec!["a1", "a2"]),
+                ("c".to_owned(), vec!["c1"]),
+            ]
+        );
+    }
 }

@@ -14,7 +14,7 @@
 //! them (Table 6.2), and are the only statistics that are not a pure function of the plan.
 
 use super::cells::Cell;
-use super::results::RunRow;
+use super::results::{RunRow, group_by};
 use std::fmt::Write as _;
 
 /// Summary fields that are not statistics of a run's results.
@@ -116,20 +116,9 @@ pub fn summarise(rows: &[RunRow]) -> SummaryTable {
         })
         .map(str::to_owned)
         .collect();
-    let mut keys: Vec<(String, Vec<(String, String)>)> = Vec::new();
-    for row in rows {
-        let key = row.group_key();
-        if !keys.contains(&key) {
-            keys.push(key);
-        }
-    }
-    let groups = keys
+    let groups = group_by(rows, |r| r.group_key())
         .into_iter()
-        .map(|(scene, coordinates)| {
-            let members: Vec<&RunRow> = rows
-                .iter()
-                .filter(|r| r.group_key() == (scene.clone(), coordinates.clone()))
-                .collect();
+        .map(|((scene, coordinates), members)| {
             let good: Vec<&&RunRow> = members.iter().filter(|r| !r.failed()).collect();
             let stats = metrics
                 .iter()

@@ -30,15 +30,6 @@ pub struct QuadState {
 }
 
 impl QuadState {
-    /// Whether every quantity is a finite number (a simulation that diverged is not).
-    pub fn is_finite(&self) -> bool {
-        self.position.is_finite()
-            && self.velocity.is_finite()
-            && self.attitude.is_finite()
-            && self.body_rates.is_finite()
-            && self.rotor_speeds.iter().all(|w| w.is_finite())
-    }
-
     /// At rest at `position`, heading `yaw` (rad about +z).
     pub fn at_rest(position: Vec3, yaw: f32) -> Self {
         Self {

@@ -102,11 +102,12 @@ pub fn step_physics(
     let mut first_unstable: Option<(usize, String)> = None;
     for (entity, uav, body, _, mut state, mut energy, ended) in &mut uavs {
         let world = &physics.world;
-        *state = QuadState::from(&world.state(body.0));
+        let flight = world.state(body.0);
+        *state = QuadState::from(&flight);
         energy.meter.clone_from(world.meter(body.0));
         energy.battery = *world.battery(body.0);
         energy.power_w = world.power_w(body.0);
-        if !(state.is_finite() && energy.power_w.is_finite()) && ended.is_none() {
+        if !(flight.is_finite() && energy.power_w.is_finite()) && ended.is_none() {
             // A diverged integration would otherwise surface ticks later, far from its cause
             // (as a sensor origin that is not finite), or run on with NaN metrics.
             let reason = format!(

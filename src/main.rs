@@ -1,6 +1,9 @@
 //! The `uavex` command line: a thin layer over `uavex_engine`.
 
+mod console;
+
 use clap::{Parser, Subcommand};
+use console::{errln, out, outln};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -184,7 +187,12 @@ fn summary_written(dir: &std::path::Path, summary: &uavex_engine::output::RunSum
 }
 
 fn main() -> ExitCode {
-    match Cli::parse().command {
+    console::exit_code(command(Cli::parse().command))
+}
+
+/// Carries out one command; its exit code.
+fn command(command: Command) -> ExitCode {
+    match command {
         Command::Sweep {
             plan,
             out,
@@ -218,10 +226,10 @@ fn main() -> ExitCode {
             let mut all_valid = true;
             for path in &scenarios {
                 match load_and_check(path) {
-                    Ok(_) => println!("{}: ok", path.display()),
+                    Ok(_) => outln!("{}: ok", path.display()),
                     Err(errors) => {
                         all_valid = false;
-                        eprintln!("{errors}");
+                        errln!("{errors}");
                     }
                 }
             }
@@ -239,20 +247,20 @@ fn main() -> ExitCode {
             wall_limit,
         } => {
             if record.is_some() && !uavex_engine::record::AVAILABLE {
-                eprintln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
+                errln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
                 return ExitCode::from(INVALID_INPUT);
             }
             let loaded = match uavex_engine::scenario::load(&scenario) {
                 Ok(loaded) => loaded,
                 Err(errors) => {
-                    eprintln!("{errors}");
+                    errln!("{errors}");
                     return ExitCode::from(INVALID_INPUT);
                 }
             };
             if let Some(dir) = &out
                 && let Err(e) = check_out_dir(dir)
             {
-                eprintln!("{e}");
+                errln!("{e}");
                 return ExitCode::from(INVALID_INPUT);
             }
             let options = RunOptions {
@@ -263,11 +271,11 @@ fn main() -> ExitCode {
             };
             match uavex_engine::run::run(&loaded, &options) {
                 Err(errors) => {
-                    eprintln!("{errors}");
+                    errln!("{errors}");
                     ExitCode::from(INVALID_INPUT)
                 }
                 Ok(summary) => {
-                    println!(
+                    outln!(
                         "{}: {} after {:.1} s simulated ({:.2} s wall), explored {:.1} %, map accuracy {}",
                         summary.scenario,
                         summary.reason,
@@ -281,13 +289,13 @@ fn main() -> ExitCode {
                     if let Some(out) = &options.out_dir {
                         // Checked before the run, but a disk can fill up during one.
                         if !summary_written(out, &summary) {
-                            eprintln!("no results written to {}", out.display());
+                            errln!("no results written to {}", out.display());
                             return ExitCode::FAILURE;
                         }
-                        println!("results in {}", out.display());
+                        outln!("results in {}", out.display());
                     }
                     if let Some(file) = options.record.as_ref().filter(|f| f.exists()) {
-                        println!("recording in {} (view it with `rerun {0}`)", file.display());
+                        outln!("recording in {} (view it with `rerun {0}`)", file.display());
                     }
                     // A crash or an empty battery is a result of the study; `failed` (a panic,
                     // the wall-clock limit, a flight that diverged) means there is none, which
@@ -313,7 +321,7 @@ fn sweep_command(
     let plan = match Plan::load(plan_path) {
         Ok(plan) => plan,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };
@@ -321,14 +329,14 @@ fn sweep_command(
     let report = match run_sweep(&plan, &options) {
         Ok(report) => report,
         Err(e) => {
-            eprintln!("sweep {}: {e}", plan.name);
+            errln!("sweep {}: {e}", plan.name);
             return ExitCode::FAILURE;
         }
     };
     let part = options
         .shard
         .map_or(String::new(), |s| format!(" (shard {s})"));
-    println!(
+    outln!(
         "sweep {}{part}: {} runs, {} finished before, {} ran in {:.1} s on {} jobs, {} failed{}",
         plan.name,
         report.planned,
@@ -344,7 +352,7 @@ fn sweep_command(
         },
     );
     for (id, reason) in &report.failed {
-        println!("  failed {id}: {}", reason_excerpt(reason, "    "));
+        outln!("  failed {id}: {}", reason_excerpt(reason, "    "));
     }
     write_results(&options.out_dir)
 }
@@ -354,14 +362,14 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
     let report = match uavex_engine::sweep::merge(out, shards) {
         Ok(report) => report,
         Err(e) => {
-            eprintln!("merge: {e}");
+            errln!("merge: {e}");
             return match e {
                 uavex_engine::sweep::SweepError::NotResults(_) => ExitCode::from(INVALID_INPUT),
                 _ => ExitCode::FAILURE,
             };
         }
     };
-    println!(
+    outln!(
         "merged {} folders into {}: {} runs copied, {} already there, {} conflicting, {} missing",
         shards.len(),
         out.display(),
@@ -371,10 +379,10 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
         report.missing.len(),
     );
     for id in &report.conflicts {
-        println!("  conflict (different results in two folders): {id}");
+        outln!("  conflict (different results in two folders): {id}");
     }
     for id in &report.missing {
-        println!("  missing: {id}");
+        outln!("  missing: {id}");
     }
     let written = write_results(out);
     if report.conflicts.is_empty() {
@@ -387,12 +395,12 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
 /// Tables and plots of a results folder.
 fn write_results(dir: &std::path::Path) -> ExitCode {
     match uavex_engine::tables::write_tables(dir) {
-        Ok(runs) => println!(
+        Ok(runs) => outln!(
             "tables of {runs} runs: {0}/runs.csv, runs.parquet, summary.csv, summary.md",
             dir.display()
         ),
         Err(e) => {
-            eprintln!("cannot write the tables of {}: {e}", dir.display());
+            errln!("cannot write the tables of {}: {e}", dir.display());
             return ExitCode::FAILURE;
         }
     }
@@ -403,7 +411,7 @@ fn write_results(dir: &std::path::Path) -> ExitCode {
 fn write_plots(dir: &std::path::Path) -> ExitCode {
     match uavex_engine::plot::plot_dir(dir) {
         Ok(files) => {
-            println!(
+            outln!(
                 "{} plot files in {}",
                 files.len(),
                 dir.join("plots").display()
@@ -411,7 +419,7 @@ fn write_plots(dir: &std::path::Path) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("cannot plot {}: {e}", dir.display());
+            errln!("cannot plot {}: {e}", dir.display());
             match e {
                 uavex_engine::plot::PlotError::NotResults(_) => ExitCode::from(INVALID_INPUT),
                 _ => ExitCode::FAILURE,
@@ -428,11 +436,11 @@ fn energy_command(model: &str, distance: f64) -> ExitCode {
         .and_then(|m| energy_report(&m, distance).map_err(|e| e.to_string()));
     match report {
         Ok(text) => {
-            print!("{text}");
+            out!("{text}");
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             ExitCode::from(INVALID_INPUT)
         }
     }
@@ -448,18 +456,18 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
     let (coverage, setup) = match setup {
         Ok(found) => found,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };
     let outcome = match setup.plan() {
         Ok(outcome) => outcome,
         Err(e) => {
-            eprintln!("{}: {e}", scenario.display());
+            errln!("{}: {e}", scenario.display());
             return ExitCode::from(INVALID_INPUT);
         }
     };
-    print!("{}", setup.report(&outcome));
+    out!("{}", setup.report(&outcome));
     let dir = out.unwrap_or(std::path::Path::new("."));
     match setup.write(&outcome, dir, &coverage.name) {
         Ok(files) => {
@@ -470,11 +478,11 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
                 &files.png,
                 &files.svg,
             ] {
-                println!("wrote {}", file.display());
+                outln!("wrote {}", file.display());
             }
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::FAILURE;
         }
     }
@@ -490,17 +498,18 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
         });
     match flown {
         Ok(c) => {
-            println!(
+            outln!(
                 "flown on the simulated {} with model `{}`:",
-                coverage.airframe, setup.model.name
+                coverage.airframe,
+                setup.model.name
             );
-            println!(
+            outln!(
                 "  energy  predicted {:>10.1} J   flown {:>10.1} J   ({:+.2} %)",
                 c.predicted_energy_j,
                 c.flown_energy_j,
                 100.0 * c.energy_error
             );
-            println!(
+            outln!(
                 "  time    predicted {:>10.1} s   flown {:>10.1} s   ({:+.2} %)",
                 c.predicted_time_s,
                 c.flown_time_s,
@@ -512,17 +521,17 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
                 .and_then(|text| std::fs::write(&path, text).map_err(|e| e.to_string()))
             {
                 Ok(()) => {
-                    println!("wrote {}", path.display());
+                    outln!("wrote {}", path.display());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
-                    eprintln!("{}: {e}", path.display());
+                    errln!("{}: {e}", path.display());
                     ExitCode::FAILURE
                 }
             }
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             ExitCode::FAILURE
         }
     }
@@ -543,7 +552,7 @@ fn calibrate_command(
     {
         Ok(airframe) => airframe,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };
@@ -552,16 +561,16 @@ fn calibrate_command(
     let calibration = match calibrate(airframe_name, &airframe, &plan) {
         Ok(calibration) => calibration,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::FAILURE;
         }
     };
     let report = fit_report(&calibration.fitted);
-    println!("{}", report.trim_end());
+    outln!("{}", report.trim_end());
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty())
         && let Err(e) = std::fs::create_dir_all(dir)
     {
-        eprintln!("cannot create {}: {e}", dir.display());
+        errln!("cannot create {}: {e}", dir.display());
         return ExitCode::FAILURE;
     }
     let stem = out.with_extension("");
@@ -572,20 +581,20 @@ fn calibrate_command(
         .and_then(|()| std::fs::write(&report_path, &report).map_err(|e| e.to_string()))
         .and_then(|()| write_measurements(&log_path, &calibration.log).map_err(|e| e.to_string()));
     if let Err(e) = written {
-        eprintln!("{e}");
+        errln!("{e}");
         return ExitCode::FAILURE;
     }
     for path in [&out, &report_path, &log_path] {
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     // Fresh legs: lengths and speeds the calibration did not fly.
     let top = airframe.max_velocity;
     let legs = [(17.0, 0.33 * top), (43.0, 0.57 * top), (95.0, 0.83 * top)];
     match check_legs(&airframe, &calibration.fitted.model, &legs) {
         Ok(checks) => {
-            println!("fresh legs, E(d, v) predicted by the fit against flown:");
+            outln!("fresh legs, E(d, v) predicted by the fit against flown:");
             for c in checks {
-                println!(
+                outln!(
                     "  {:>6.1} m at {:>5.2} m/s: predicted {:>8.1} J, flown {:>8.1} J ({:+.2} %)",
                     c.distance_m,
                     c.speed,
@@ -597,7 +606,7 @@ fn calibrate_command(
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             ExitCode::FAILURE
         }
     }

@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 use uavex_components::sim::Outcome;
-use uavex_engine::run::{RunOptions, load_and_check};
+use uavex_engine::run::{RunOptions, RunReport, load_and_check};
 
 #[derive(Parser)]
 #[command(
@@ -176,16 +176,6 @@ fn check_out_dir(dir: &std::path::Path) -> Result<(), String> {
     std::fs::remove_file(&probe).map_err(cannot)
 }
 
-/// True when `dir/summary.json` is the summary of this run. The run writes it last and, when
-/// writing fails, reports that in the returned summary's reason instead; a summary left by an
-/// earlier run never has that reason, so an equal reason means the file is this run's.
-fn summary_written(dir: &std::path::Path, summary: &uavex_engine::output::RunSummary) -> bool {
-    std::fs::read_to_string(dir.join(uavex_engine::sweep::execute::SUMMARY_FILE))
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .is_some_and(|written| written["reason"] == summary.reason.as_str())
-}
-
 fn main() -> ExitCode {
     console::exit_code(command(Cli::parse().command))
 }
@@ -274,7 +264,10 @@ fn command(command: Command) -> ExitCode {
                     errln!("{errors}");
                     ExitCode::from(INVALID_INPUT)
                 }
-                Ok(summary) => {
+                Ok(RunReport {
+                    summary,
+                    write_error,
+                }) => {
                     outln!(
                         "{}: {} after {:.1} s simulated ({:.2} s wall), explored {:.1} %, map accuracy {}",
                         summary.scenario,
@@ -286,12 +279,12 @@ fn command(command: Command) -> ExitCode {
                             .map_accuracy
                             .map_or("n/a".to_owned(), |a| format!("{:.2} %", a * 100.0)),
                     );
+                    // Checked before the run, but a disk can fill up during one.
+                    if let Some(e) = &write_error {
+                        errln!("no results written to {}", e.dir.display());
+                        return ExitCode::FAILURE;
+                    }
                     if let Some(out) = &options.out_dir {
-                        // Checked before the run, but a disk can fill up during one.
-                        if !summary_written(out, &summary) {
-                            errln!("no results written to {}", out.display());
-                            return ExitCode::FAILURE;
-                        }
                         outln!("results in {}", out.display());
                     }
                     if let Some(file) = options.record.as_ref().filter(|f| f.exists()) {

@@ -166,14 +166,40 @@ fn jobs(text: &str) -> Result<usize, String> {
 }
 
 /// Makes sure run results can be written into `dir` before the run, not after it: creates
-/// the folder and writes and removes a file in it.
-fn check_out_dir(dir: &std::path::Path) -> Result<(), String> {
-    let cannot =
-        |e: std::io::Error| format!("--out {}: cannot write results there: {e}", dir.display());
-    std::fs::create_dir_all(dir).map_err(cannot)?;
+/// the folder and writes and removes a file in it. Returns the folders it created, deepest
+/// first, for [`remove_created`] should the run be refused after all.
+fn check_out_dir(dir: &std::path::Path) -> Result<Vec<PathBuf>, String> {
+    let created: Vec<PathBuf> = dir
+        .ancestors()
+        .take_while(|d| !d.as_os_str().is_empty() && d.symlink_metadata().is_err())
+        .map(PathBuf::from)
+        .collect();
     let probe = dir.join(format!(".uavex-write-check-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(cannot)?;
-    std::fs::remove_file(&probe).map_err(cannot)
+    let checked = std::fs::create_dir_all(dir)
+        .and_then(|()| std::fs::write(&probe, b""))
+        .and_then(|()| std::fs::remove_file(&probe));
+    match checked {
+        Ok(()) => Ok(created),
+        Err(e) => {
+            remove_created(&created);
+            Err(format!(
+                "--out {}: cannot write results there: {e}",
+                dir.display()
+            ))
+        }
+    }
+}
+
+/// Removes the folders [`check_out_dir`] created (deepest first), each only while it is empty:
+/// a refused run leaves no folder of its own behind (an empty `--out` folder looked like a run
+/// that wrote nothing), and never takes anything that was put there meanwhile. Folders that
+/// were there before the check are not in `created`, and stay as they were.
+fn remove_created(created: &[PathBuf]) {
+    for dir in created {
+        if std::fs::remove_dir(dir).is_err() {
+            break;
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -247,12 +273,13 @@ fn command(command: Command) -> ExitCode {
                     return ExitCode::from(INVALID_INPUT);
                 }
             };
-            if let Some(dir) = &out
-                && let Err(e) = check_out_dir(dir)
-            {
-                errln!("{e}");
-                return ExitCode::from(INVALID_INPUT);
-            }
+            let created = match out.as_deref().map(check_out_dir).transpose() {
+                Ok(created) => created.unwrap_or_default(),
+                Err(e) => {
+                    errln!("{e}");
+                    return ExitCode::from(INVALID_INPUT);
+                }
+            };
             let options = RunOptions {
                 out_dir: out,
                 seed,
@@ -260,8 +287,10 @@ fn command(command: Command) -> ExitCode {
                 wall_limit,
             };
             match uavex_engine::run::run(&loaded, &options) {
+                // The world was refused: the run did not start and wrote nothing.
                 Err(errors) => {
                     errln!("{errors}");
+                    remove_created(&created);
                     ExitCode::from(INVALID_INPUT)
                 }
                 Ok(RunReport {

@@ -1,11 +1,14 @@
 //! The `uavex` command line: a thin layer over `uavex_engine`.
 
+mod console;
+
 use clap::{Parser, Subcommand};
+use console::{errln, out, outln};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 use uavex_components::sim::Outcome;
-use uavex_engine::run::{RunOptions, load_and_check};
+use uavex_engine::run::{RunOptions, RunReport, load_and_check};
 
 #[derive(Parser)]
 #[command(
@@ -163,28 +166,49 @@ fn jobs(text: &str) -> Result<usize, String> {
 }
 
 /// Makes sure run results can be written into `dir` before the run, not after it: creates
-/// the folder and writes and removes a file in it.
-fn check_out_dir(dir: &std::path::Path) -> Result<(), String> {
-    let cannot =
-        |e: std::io::Error| format!("--out {}: cannot write results there: {e}", dir.display());
-    std::fs::create_dir_all(dir).map_err(cannot)?;
+/// the folder and writes and removes a file in it. Returns the folders it created, deepest
+/// first, for [`remove_created`] should the run be refused after all.
+fn check_out_dir(dir: &std::path::Path) -> Result<Vec<PathBuf>, String> {
+    let created: Vec<PathBuf> = dir
+        .ancestors()
+        .take_while(|d| !d.as_os_str().is_empty() && d.symlink_metadata().is_err())
+        .map(PathBuf::from)
+        .collect();
     let probe = dir.join(format!(".uavex-write-check-{}", std::process::id()));
-    std::fs::write(&probe, b"").map_err(cannot)?;
-    std::fs::remove_file(&probe).map_err(cannot)
+    let checked = std::fs::create_dir_all(dir)
+        .and_then(|()| std::fs::write(&probe, b""))
+        .and_then(|()| std::fs::remove_file(&probe));
+    match checked {
+        Ok(()) => Ok(created),
+        Err(e) => {
+            remove_created(&created);
+            Err(format!(
+                "--out {}: cannot write results there: {e}",
+                dir.display()
+            ))
+        }
+    }
 }
 
-/// True when `dir/summary.json` is the summary of this run. The run writes it last and, when
-/// writing fails, reports that in the returned summary's reason instead; a summary left by an
-/// earlier run never has that reason, so an equal reason means the file is this run's.
-fn summary_written(dir: &std::path::Path, summary: &uavex_engine::output::RunSummary) -> bool {
-    std::fs::read_to_string(dir.join(uavex_engine::sweep::execute::SUMMARY_FILE))
-        .ok()
-        .and_then(|text| serde_json::from_str::<serde_json::Value>(&text).ok())
-        .is_some_and(|written| written["reason"] == summary.reason.as_str())
+/// Removes the folders [`check_out_dir`] created (deepest first), each only while it is empty:
+/// a refused run leaves no folder of its own behind (an empty `--out` folder looked like a run
+/// that wrote nothing), and never takes anything that was put there meanwhile. Folders that
+/// were there before the check are not in `created`, and stay as they were.
+fn remove_created(created: &[PathBuf]) {
+    for dir in created {
+        if std::fs::remove_dir(dir).is_err() {
+            break;
+        }
+    }
 }
 
 fn main() -> ExitCode {
-    match Cli::parse().command {
+    console::exit_code(command(Cli::parse().command))
+}
+
+/// Carries out one command; its exit code.
+fn command(command: Command) -> ExitCode {
+    match command {
         Command::Sweep {
             plan,
             out,
@@ -218,10 +242,10 @@ fn main() -> ExitCode {
             let mut all_valid = true;
             for path in &scenarios {
                 match load_and_check(path) {
-                    Ok(_) => println!("{}: ok", path.display()),
+                    Ok(_) => outln!("{}: ok", path.display()),
                     Err(errors) => {
                         all_valid = false;
-                        eprintln!("{errors}");
+                        errln!("{errors}");
                     }
                 }
             }
@@ -239,22 +263,23 @@ fn main() -> ExitCode {
             wall_limit,
         } => {
             if record.is_some() && !uavex_engine::record::AVAILABLE {
-                eprintln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
+                errln!("--record: {}", uavex_engine::record::FEATURE_MISSING);
                 return ExitCode::from(INVALID_INPUT);
             }
             let loaded = match uavex_engine::scenario::load(&scenario) {
                 Ok(loaded) => loaded,
                 Err(errors) => {
-                    eprintln!("{errors}");
+                    errln!("{errors}");
                     return ExitCode::from(INVALID_INPUT);
                 }
             };
-            if let Some(dir) = &out
-                && let Err(e) = check_out_dir(dir)
-            {
-                eprintln!("{e}");
-                return ExitCode::from(INVALID_INPUT);
-            }
+            let created = match out.as_deref().map(check_out_dir).transpose() {
+                Ok(created) => created.unwrap_or_default(),
+                Err(e) => {
+                    errln!("{e}");
+                    return ExitCode::from(INVALID_INPUT);
+                }
+            };
             let options = RunOptions {
                 out_dir: out,
                 seed,
@@ -262,12 +287,17 @@ fn main() -> ExitCode {
                 wall_limit,
             };
             match uavex_engine::run::run(&loaded, &options) {
+                // The world was refused: the run did not start and wrote nothing.
                 Err(errors) => {
-                    eprintln!("{errors}");
+                    errln!("{errors}");
+                    remove_created(&created);
                     ExitCode::from(INVALID_INPUT)
                 }
-                Ok(summary) => {
-                    println!(
+                Ok(RunReport {
+                    summary,
+                    write_error,
+                }) => {
+                    outln!(
                         "{}: {} after {:.1} s simulated ({:.2} s wall), explored {:.1} %, map accuracy {}",
                         summary.scenario,
                         summary.reason,
@@ -278,16 +308,16 @@ fn main() -> ExitCode {
                             .map_accuracy
                             .map_or("n/a".to_owned(), |a| format!("{:.2} %", a * 100.0)),
                     );
+                    // Checked before the run, but a disk can fill up during one.
+                    if let Some(e) = &write_error {
+                        errln!("no results written to {}", e.dir.display());
+                        return ExitCode::FAILURE;
+                    }
                     if let Some(out) = &options.out_dir {
-                        // Checked before the run, but a disk can fill up during one.
-                        if !summary_written(out, &summary) {
-                            eprintln!("no results written to {}", out.display());
-                            return ExitCode::FAILURE;
-                        }
-                        println!("results in {}", out.display());
+                        outln!("results in {}", out.display());
                     }
                     if let Some(file) = options.record.as_ref().filter(|f| f.exists()) {
-                        println!("recording in {} (view it with `rerun {0}`)", file.display());
+                        outln!("recording in {} (view it with `rerun {0}`)", file.display());
                     }
                     // A crash or an empty battery is a result of the study; `failed` (a panic,
                     // the wall-clock limit, a flight that diverged) means there is none, which
@@ -313,7 +343,7 @@ fn sweep_command(
     let plan = match Plan::load(plan_path) {
         Ok(plan) => plan,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };
@@ -321,14 +351,14 @@ fn sweep_command(
     let report = match run_sweep(&plan, &options) {
         Ok(report) => report,
         Err(e) => {
-            eprintln!("sweep {}: {e}", plan.name);
+            errln!("sweep {}: {e}", plan.name);
             return ExitCode::FAILURE;
         }
     };
     let part = options
         .shard
         .map_or(String::new(), |s| format!(" (shard {s})"));
-    println!(
+    outln!(
         "sweep {}{part}: {} runs, {} finished before, {} ran in {:.1} s on {} jobs, {} failed{}",
         plan.name,
         report.planned,
@@ -344,7 +374,7 @@ fn sweep_command(
         },
     );
     for (id, reason) in &report.failed {
-        println!("  failed {id}: {}", reason_excerpt(reason, "    "));
+        outln!("  failed {id}: {}", reason_excerpt(reason, "    "));
     }
     write_results(&options.out_dir)
 }
@@ -354,14 +384,14 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
     let report = match uavex_engine::sweep::merge(out, shards) {
         Ok(report) => report,
         Err(e) => {
-            eprintln!("merge: {e}");
+            errln!("merge: {e}");
             return match e {
                 uavex_engine::sweep::SweepError::NotResults(_) => ExitCode::from(INVALID_INPUT),
                 _ => ExitCode::FAILURE,
             };
         }
     };
-    println!(
+    outln!(
         "merged {} folders into {}: {} runs copied, {} already there, {} conflicting, {} missing",
         shards.len(),
         out.display(),
@@ -371,10 +401,10 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
         report.missing.len(),
     );
     for id in &report.conflicts {
-        println!("  conflict (different results in two folders): {id}");
+        outln!("  conflict (different results in two folders): {id}");
     }
     for id in &report.missing {
-        println!("  missing: {id}");
+        outln!("  missing: {id}");
     }
     let written = write_results(out);
     if report.conflicts.is_empty() {
@@ -387,12 +417,12 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
 /// Tables and plots of a results folder.
 fn write_results(dir: &std::path::Path) -> ExitCode {
     match uavex_engine::tables::write_tables(dir) {
-        Ok(runs) => println!(
+        Ok(runs) => outln!(
             "tables of {runs} runs: {0}/runs.csv, runs.parquet, summary.csv, summary.md",
             dir.display()
         ),
         Err(e) => {
-            eprintln!("cannot write the tables of {}: {e}", dir.display());
+            errln!("cannot write the tables of {}: {e}", dir.display());
             return ExitCode::FAILURE;
         }
     }
@@ -403,7 +433,7 @@ fn write_results(dir: &std::path::Path) -> ExitCode {
 fn write_plots(dir: &std::path::Path) -> ExitCode {
     match uavex_engine::plot::plot_dir(dir) {
         Ok(files) => {
-            println!(
+            outln!(
                 "{} plot files in {}",
                 files.len(),
                 dir.join("plots").display()
@@ -411,7 +441,7 @@ fn write_plots(dir: &std::path::Path) -> ExitCode {
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("cannot plot {}: {e}", dir.display());
+            errln!("cannot plot {}: {e}", dir.display());
             match e {
                 uavex_engine::plot::PlotError::NotResults(_) => ExitCode::from(INVALID_INPUT),
                 _ => ExitCode::FAILURE,
@@ -428,11 +458,11 @@ fn energy_command(model: &str, distance: f64) -> ExitCode {
         .and_then(|m| energy_report(&m, distance).map_err(|e| e.to_string()));
     match report {
         Ok(text) => {
-            print!("{text}");
+            out!("{text}");
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             ExitCode::from(INVALID_INPUT)
         }
     }
@@ -448,18 +478,18 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
     let (coverage, setup) = match setup {
         Ok(found) => found,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };
     let outcome = match setup.plan() {
         Ok(outcome) => outcome,
         Err(e) => {
-            eprintln!("{}: {e}", scenario.display());
+            errln!("{}: {e}", scenario.display());
             return ExitCode::from(INVALID_INPUT);
         }
     };
-    print!("{}", setup.report(&outcome));
+    out!("{}", setup.report(&outcome));
     let dir = out.unwrap_or(std::path::Path::new("."));
     match setup.write(&outcome, dir, &coverage.name) {
         Ok(files) => {
@@ -470,11 +500,11 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
                 &files.png,
                 &files.svg,
             ] {
-                println!("wrote {}", file.display());
+                outln!("wrote {}", file.display());
             }
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::FAILURE;
         }
     }
@@ -490,17 +520,18 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
         });
     match flown {
         Ok(c) => {
-            println!(
+            outln!(
                 "flown on the simulated {} with model `{}`:",
-                coverage.airframe, setup.model.name
+                coverage.airframe,
+                setup.model.name
             );
-            println!(
+            outln!(
                 "  energy  predicted {:>10.1} J   flown {:>10.1} J   ({:+.2} %)",
                 c.predicted_energy_j,
                 c.flown_energy_j,
                 100.0 * c.energy_error
             );
-            println!(
+            outln!(
                 "  time    predicted {:>10.1} s   flown {:>10.1} s   ({:+.2} %)",
                 c.predicted_time_s,
                 c.flown_time_s,
@@ -512,17 +543,17 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
                 .and_then(|text| std::fs::write(&path, text).map_err(|e| e.to_string()))
             {
                 Ok(()) => {
-                    println!("wrote {}", path.display());
+                    outln!("wrote {}", path.display());
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
-                    eprintln!("{}: {e}", path.display());
+                    errln!("{}: {e}", path.display());
                     ExitCode::FAILURE
                 }
             }
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             ExitCode::FAILURE
         }
     }
@@ -543,7 +574,7 @@ fn calibrate_command(
     {
         Ok(airframe) => airframe,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };
@@ -552,16 +583,16 @@ fn calibrate_command(
     let calibration = match calibrate(airframe_name, &airframe, &plan) {
         Ok(calibration) => calibration,
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             return ExitCode::FAILURE;
         }
     };
     let report = fit_report(&calibration.fitted);
-    println!("{}", report.trim_end());
+    outln!("{}", report.trim_end());
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty())
         && let Err(e) = std::fs::create_dir_all(dir)
     {
-        eprintln!("cannot create {}: {e}", dir.display());
+        errln!("cannot create {}: {e}", dir.display());
         return ExitCode::FAILURE;
     }
     let stem = out.with_extension("");
@@ -572,20 +603,20 @@ fn calibrate_command(
         .and_then(|()| std::fs::write(&report_path, &report).map_err(|e| e.to_string()))
         .and_then(|()| write_measurements(&log_path, &calibration.log).map_err(|e| e.to_string()));
     if let Err(e) = written {
-        eprintln!("{e}");
+        errln!("{e}");
         return ExitCode::FAILURE;
     }
     for path in [&out, &report_path, &log_path] {
-        println!("wrote {}", path.display());
+        outln!("wrote {}", path.display());
     }
     // Fresh legs: lengths and speeds the calibration did not fly.
     let top = airframe.max_velocity;
     let legs = [(17.0, 0.33 * top), (43.0, 0.57 * top), (95.0, 0.83 * top)];
     match check_legs(&airframe, &calibration.fitted.model, &legs) {
         Ok(checks) => {
-            println!("fresh legs, E(d, v) predicted by the fit against flown:");
+            outln!("fresh legs, E(d, v) predicted by the fit against flown:");
             for c in checks {
-                println!(
+                outln!(
                     "  {:>6.1} m at {:>5.2} m/s: predicted {:>8.1} J, flown {:>8.1} J ({:+.2} %)",
                     c.distance_m,
                     c.speed,
@@ -597,7 +628,7 @@ fn calibrate_command(
             ExitCode::SUCCESS
         }
         Err(e) => {
-            eprintln!("{e}");
+            errln!("{e}");
             ExitCode::FAILURE
         }
     }

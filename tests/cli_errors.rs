@@ -203,3 +203,33 @@ behaviour = {{ kind = "waypoints", waypoints = [[2.4, 0.0, 1.0]], collision_chec
         "its outputs are kept"
     );
 }
+
+#[test]
+fn a_refused_run_leaves_no_output_folder_it_created() {
+    let dir = room_plan(1, "");
+    // Read, and the `--out` folder checked, before the world builder finds no mesh file.
+    std::fs::write(
+        dir.path().join("bad_world.toml"),
+        format!("{ROOM}\n[[world.obstacle]]\nkind = \"mesh\"\nfile = \"missing.obj\"\n"),
+    )
+    .unwrap();
+    let refused = |out_dir: &str| {
+        let (code, out, err) = uavex(dir.path(), &["run", "bad_world.toml", "--out", out_dir]);
+        assert_eq!(code, Some(2), "{out_dir}: {out}{err}");
+        assert!(err.contains("missing.obj: cannot read the file"), "{err}");
+    };
+    refused("new/deeper");
+    assert!(!dir.path().join("new").exists(), "both levels removed");
+    // Folders that were there before stay, with what they held; only the new level goes.
+    std::fs::create_dir_all(dir.path().join("old/empty")).unwrap();
+    std::fs::write(dir.path().join("old/notes.txt"), "keep").unwrap();
+    for out_dir in ["old", "old/empty", "old/new"] {
+        refused(out_dir);
+    }
+    assert!(dir.path().join("old/empty").is_dir());
+    assert!(!dir.path().join("old/new").exists());
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("old/notes.txt")).unwrap(),
+        "keep"
+    );
+}

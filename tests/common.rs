@@ -12,7 +12,9 @@ pub fn scenario(text: &str) -> LoadedScenario {
 
 /// Runs a loaded scenario without writing files.
 pub fn run_quietly(loaded: &LoadedScenario) -> RunSummary {
-    run(loaded, &RunOptions::default()).unwrap_or_else(|e| panic!("world refused:\n{e}"))
+    run(loaded, &RunOptions::default())
+        .unwrap_or_else(|e| panic!("world refused:\n{e}"))
+        .summary
 }
 
 /// A 10 x 10 x 3 m room around the origin with walls at x = +-4 m (faces at +-4.0).

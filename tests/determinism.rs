@@ -56,7 +56,7 @@ fn run_in_pool(threads: usize, dir: &std::path::Path) -> (RunSummary, String, St
         seed: None,
         ..RunOptions::default()
     };
-    let mut summary = pool.install(|| run(&loaded, &options)).unwrap();
+    let mut summary = pool.install(|| run(&loaded, &options)).unwrap().summary;
     summary.wall_time_s = 0.0; // the one field that measures the host, not the run
     let read = |name: &str| std::fs::read_to_string(dir.join(name)).unwrap();
     (summary, read("series.csv"), read("uavs.csv"))
@@ -78,7 +78,7 @@ fn same_seed_gives_identical_results_on_one_and_two_threads() {
 #[test]
 fn another_seed_gives_another_run() {
     let loaded = common::scenario(SCENARIO);
-    let a = run(&loaded, &RunOptions::default()).unwrap();
+    let a = run(&loaded, &RunOptions::default()).unwrap().summary;
     let b = run(
         &loaded,
         &RunOptions {
@@ -87,7 +87,8 @@ fn another_seed_gives_another_run() {
             ..RunOptions::default()
         },
     )
-    .unwrap();
+    .unwrap()
+    .summary;
     assert_ne!(
         a.known_voxels, b.known_voxels,
         "seed 12 should draw other pillars and noise"

@@ -49,6 +49,7 @@ fn run_seed(loaded: &LoadedScenario, seed: u64) -> RunSummary {
         },
     )
     .unwrap_or_else(|e| panic!("{e}"))
+    .summary
 }
 
 /// Explored to >= 95 % of the reachable volume, complete, no crash.
@@ -193,7 +194,9 @@ fn a_battery_limited_run_returns_home() {
         position.distance(glam::Vec3::new(0.0, 0.0, 1.0)) < 0.35,
         "{position}"
     );
-    let summary = run(&loaded, &RunOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let summary = run(&loaded, &RunOptions::default())
+        .unwrap_or_else(|e| panic!("{e}"))
+        .summary;
     assert_eq!(summary.outcome, Outcome::ReturnedHome);
     assert_eq!(summary.uavs[0].status, "returned_home");
     // It never drew into the reserve it kept for the way home.

@@ -50,7 +50,7 @@ fn a_uav_flown_into_a_wall_crashes_there_and_summary_json_says_so() {
         seed: None,
         ..RunOptions::default()
     };
-    let summary = run(&loaded, &options).unwrap();
+    let summary = run(&loaded, &options).unwrap().summary;
     assert_eq!(summary.outcome, Outcome::Crashed, "{}", summary.reason);
     assert!(
         summary.reason.contains("obstacle 'east'"),

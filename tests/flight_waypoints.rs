@@ -26,7 +26,7 @@ fn the_pillars_tour_completes_with_plausible_energy_and_series() {
         seed: None,
         ..RunOptions::default()
     };
-    let summary = run(&loaded, &options).unwrap();
+    let summary = run(&loaded, &options).unwrap().summary;
     assert_eq!(summary.outcome, Outcome::Complete, "{}", summary.reason);
     let uav = &summary.uavs[0];
     assert_eq!(uav.status, "finished");

@@ -46,7 +46,9 @@ fn run_into(loaded: &LoadedScenario, dir: &Path, record: Option<PathBuf>) -> Run
         record,
         ..RunOptions::default()
     };
-    run(loaded, &options).unwrap_or_else(|e| panic!("{e}"))
+    run(loaded, &options)
+        .unwrap_or_else(|e| panic!("{e}"))
+        .summary
 }
 
 /// A recording's data chunks, as rerun's decoder reads them back.
@@ -390,7 +392,8 @@ fn a_recording_that_fails_while_writing_fails_the_run_with_the_reason() {
             ..RunOptions::default()
         },
     )
-    .unwrap();
+    .unwrap()
+    .summary;
     assert_eq!(summary.outcome, Outcome::Failed);
     assert!(
         summary.reason.starts_with("could not write the recording")

@@ -49,15 +49,36 @@ pub fn load_and_check(path: &Path) -> Result<LoadedScenario, ScenarioErrors> {
     Ok(loaded)
 }
 
+/// What a run gives back: its summary, and whether its results folder was written.
+#[derive(Debug)]
+pub struct RunReport {
+    pub summary: RunSummary,
+    /// Set when the run's files could not all be written into [`RunOptions::out_dir`] (`None`
+    /// also when no folder was asked for). The summary says it too, as its reason with the
+    /// outcome `failed`, for the tables of a sweep; a caller tells a write that failed by this
+    /// field, not by reading the reason.
+    pub write_error: Option<WriteError>,
+}
+
+/// A run's results folder that could not be written (a full disk, a folder where a file goes).
+/// Its text is the reason the run's summary gets.
+#[derive(Debug, thiserror::Error)]
+#[error("could not write results to {}: {source}", dir.display())]
+pub struct WriteError {
+    pub dir: PathBuf,
+    pub source: std::io::Error,
+}
+
 /// Loads, checks and runs a scenario file.
-pub fn run_file(path: &Path, options: &RunOptions) -> Result<RunSummary, ScenarioErrors> {
+pub fn run_file(path: &Path, options: &RunOptions) -> Result<RunReport, ScenarioErrors> {
     let loaded = scenario::load(path)?;
     run(&loaded, options)
 }
 
 /// Runs a loaded scenario. `Err` only for a scenario the world builder refuses; once the run
-/// has started, every ending (including a panic) is a summary.
-pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, ScenarioErrors> {
+/// has started, every ending (including a panic, and results that could not be written) is a
+/// report.
+pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunReport, ScenarioErrors> {
     let seed = options.seed.unwrap_or(loaded.scenario.seed);
     let started = Instant::now();
     let mut sim = Sim::build(loaded, seed)?;
@@ -93,13 +114,22 @@ pub fn run(loaded: &LoadedScenario, options: &RunOptions) -> Result<RunSummary, 
         summary.outcome = Outcome::Failed;
     }
     summary.wall_time_s = started.elapsed().as_secs_f64();
-    if let Some(dir) = &options.out_dir
-        && let Err(e) = write_outputs(&mut sim, &summary, dir, loaded.scenario.outputs.export_map)
-    {
+    let write_error = options.out_dir.as_ref().and_then(|dir| {
+        write_outputs(&mut sim, &summary, dir, loaded.scenario.outputs.export_map)
+            .err()
+            .map(|source| WriteError {
+                dir: dir.clone(),
+                source,
+            })
+    });
+    if let Some(e) = &write_error {
         summary.outcome = Outcome::Failed;
-        summary.reason = format!("could not write results to {}: {e}", dir.display());
+        summary.reason = e.to_string();
     }
-    Ok(summary)
+    Ok(RunReport {
+        summary,
+        write_error,
+    })
 }
 
 /// The text a panic was raised with.

@@ -17,7 +17,7 @@ use super::expand::{RunSpec, Shard, expand};
 use super::plan::Plan;
 use super::schedule::RunQueue;
 use crate::output::write_atomically;
-use crate::run::{RunOptions, run as run_scenario};
+use crate::run::{RunOptions, RunReport, run as run_scenario};
 use crate::scenario::parse_str;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
@@ -363,9 +363,14 @@ fn attempt_run(
         record: None,
         wall_limit,
     };
-    let summary = run_scenario(&loaded, &options)
+    let RunReport {
+        summary,
+        write_error,
+    } = run_scenario(&loaded, &options)
         .map_err(|errors| format!("the world was refused:\n{errors}"))?;
-    if !is_finished(dir) {
+    // Its files were not written: the reason says why, and `execute_run` writes it as the
+    // run's summary.
+    if write_error.is_some() {
         return Err(summary.reason);
     }
     Ok((summary.outcome == Outcome::Failed).then_some(summary.reason))

@@ -1,9 +1,11 @@
 //! The `uavex` command line: a thin layer over `uavex_engine`.
 
 mod console;
+mod out_dir;
 
 use clap::{Parser, Subcommand};
 use console::{errln, out, outln};
+use out_dir::{check_out_dir, remove_created};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -162,43 +164,6 @@ fn jobs(text: &str) -> Result<usize, String> {
             "expected a number of runs at once from 1 to {MAX_JOBS}, got {text:?} \
              (leave --jobs out for one per core)"
         )),
-    }
-}
-
-/// Makes sure run results can be written into `dir` before the run, not after it: creates
-/// the folder and writes and removes a file in it. Returns the folders it created, deepest
-/// first, for [`remove_created`] should the run be refused after all.
-fn check_out_dir(dir: &std::path::Path) -> Result<Vec<PathBuf>, String> {
-    let created: Vec<PathBuf> = dir
-        .ancestors()
-        .take_while(|d| !d.as_os_str().is_empty() && d.symlink_metadata().is_err())
-        .map(PathBuf::from)
-        .collect();
-    let probe = dir.join(format!(".uavex-write-check-{}", std::process::id()));
-    let checked = std::fs::create_dir_all(dir)
-        .and_then(|()| std::fs::write(&probe, b""))
-        .and_then(|()| std::fs::remove_file(&probe));
-    match checked {
-        Ok(()) => Ok(created),
-        Err(e) => {
-            remove_created(&created);
-            Err(format!(
-                "--out {}: cannot write results there: {e}",
-                dir.display()
-            ))
-        }
-    }
-}
-
-/// Removes the folders [`check_out_dir`] created (deepest first), each only while it is empty:
-/// a refused run leaves no folder of its own behind (an empty `--out` folder looked like a run
-/// that wrote nothing), and never takes anything that was put there meanwhile. Folders that
-/// were there before the check are not in `created`, and stay as they were.
-fn remove_created(created: &[PathBuf]) {
-    for dir in created {
-        if std::fs::remove_dir(dir).is_err() {
-            break;
-        }
     }
 }
 

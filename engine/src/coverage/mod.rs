@@ -32,6 +32,7 @@ pub use report::{cover_report, energy_report, fit_report};
 pub use scenario::{CoverageScenario, read_coverage_scenario};
 pub use spec::{AreaSpec, CoverageSetup, CoverageSpec};
 
+use crate::scenario::ScenarioErrors;
 use std::path::PathBuf;
 use thiserror::Error;
 use uavex_systems::coverage::{FitError, MissionError, PolygonError};
@@ -66,6 +67,9 @@ pub enum CoverageIoError {
     /// named: the caller knows the scenario (`uavex cover` puts it in front).
     #[error("coverage {field}: {source}")]
     Plan { field: String, source: MissionError },
+    /// Problems of a scenario file, each at its line and field (`uavex cover`).
+    #[error(transparent)]
+    Scenario(#[from] ScenarioErrors),
     /// A simulated flight (calibration or flying a plan) failed.
     #[error("simulated flight: {0}")]
     Flight(String),

@@ -35,7 +35,7 @@ pub use spec::{AreaSpec, CoverageSetup, CoverageSpec};
 use crate::scenario::ScenarioErrors;
 use std::path::PathBuf;
 use thiserror::Error;
-use uavex_systems::coverage::{FitError, MissionError, PolygonError};
+use uavex_systems::coverage::{EnergyModelError, FitError, MissionError, PolygonError};
 
 /// Anything that goes wrong reading coverage inputs or writing coverage outputs, with the file.
 #[derive(Debug, Error)]
@@ -59,6 +59,13 @@ pub enum CoverageIoError {
     },
     #[error("{path}: cannot fit an energy model: {source}")]
     Fit { path: PathBuf, source: FitError },
+    /// The fit succeeded but gives a model the model loader refuses (power not positive over
+    /// the measured speeds, non-finite coefficients); `path` names the data it came from.
+    #[error("{path}: the model fitted from these measurements is unusable: {source}")]
+    UnusableFit {
+        path: PathBuf,
+        source: EnergyModelError,
+    },
     #[error("{path}: drawing failed: {message}")]
     Picture { path: PathBuf, message: String },
     #[error(transparent)]

@@ -437,7 +437,7 @@ fn energy_command(model: &str, distance: f64) -> ExitCode {
 fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly: bool) -> ExitCode {
     use uavex_engine::coverage::read_coverage_scenario;
     let setup = read_coverage_scenario(scenario).and_then(|s| {
-        let setup = s.spec.resolve(s.base_dir(), &s.path)?;
+        let setup = s.resolve()?;
         Ok((s, setup))
     });
     let (coverage, setup) = match setup {
@@ -447,10 +447,10 @@ fn cover_command(scenario: &std::path::Path, out: Option<&std::path::Path>, fly:
             return ExitCode::from(INVALID_INPUT);
         }
     };
-    let outcome = match setup.plan() {
+    let outcome = match coverage.plan(&setup) {
         Ok(outcome) => outcome,
         Err(e) => {
-            errln!("{}: {e}", scenario.display());
+            errln!("{e}");
             return ExitCode::from(INVALID_INPUT);
         }
     };

@@ -102,6 +102,42 @@ fn cover_refuses_a_scenario_without_a_coverage_uav() {
 }
 
 #[test]
+fn cover_shows_problems_at_their_line_and_field() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("bad.toml");
+    let text = std::fs::read_to_string("scenarios/coverage_field.toml").unwrap();
+    let line = 1 + text
+        .lines()
+        .position(|l| l.starts_with("overlap = { x = 0.2"))
+        .unwrap();
+    let typo = text.replacen("overlap = { x = 0.2", "overlap = { x = 1.5, y_was = 0.2", 1);
+    std::fs::write(&path, typo).unwrap();
+    let output = uavex(&["cover", path.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let error = String::from_utf8_lossy(&output.stderr);
+    // The typo is reported by the loader's decoding, at the key.
+    assert!(
+        error.starts_with(&format!(
+            "{}:{line}:22: uav[0].behaviour.overlap.y_was: unknown field",
+            path.display()
+        )),
+        "{error}"
+    );
+    let out_of_range = text.replacen("overlap = { x = 0.2", "overlap = { x = 1.5", 1);
+    std::fs::write(&path, out_of_range).unwrap();
+    let output = uavex(&["cover", path.to_str().unwrap()]);
+    assert_eq!(output.status.code(), Some(2));
+    let error = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(
+        error.trim_end(),
+        format!(
+            "{}:{line}:17: uav[0].behaviour.overlap.x: overlap along x must lie in [0, 1), got 1.5",
+            path.display()
+        )
+    );
+}
+
+#[test]
 fn calibrate_writes_a_model_that_energy_reads() {
     let dir = tempfile::tempdir().unwrap();
     let model = dir.path().join("models").join("kf.json");

@@ -5,6 +5,7 @@
 
 use super::CoverageIoError;
 use super::flight::plan_profile;
+use super::scenario::scenario_field;
 use super::spec::CoverageSpec;
 use crate::flight::{Physics, dynamic_flight};
 use crate::scenario::UavSpec;
@@ -24,16 +25,8 @@ const START_TOLERANCE_M: f64 = 1.0;
 /// A coverage problem at the scenario field it concerns (`uav[0].behaviour.overlap.y`), so the
 /// loader shows its line; problems of no one field stay at the behaviour.
 fn located(index: usize, error: CoverageIoError) -> BuildError {
-    let behaviour = format!("uav[{index}].behaviour");
-    match error {
-        CoverageIoError::Spec { field, message, .. } => {
-            BuildError::new(format!("{behaviour}.{field}"), message)
-        }
-        CoverageIoError::Plan { field, source } => {
-            BuildError::new(format!("{behaviour}.{field}"), source.to_string())
-        }
-        other => BuildError::new(behaviour, other.to_string()),
-    }
+    let (field, message) = scenario_field(index, error);
+    BuildError::new(field, message)
 }
 
 /// Plans `uav[index]`'s coverage mission and returns the components that fly it, hovering at

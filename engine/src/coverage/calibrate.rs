@@ -10,15 +10,18 @@
 //! - hovering, climbing and descending at constant vertical speeds, and a full turn in place.
 //!
 //! Every physics step is a row (time, speed, power, phase), the phase being the one of the
-//! reference flown at that instant; [`fit_model`] then fits the curves by least squares.
+//! reference flown at that instant; [`fit_model`](uavex_systems::coverage::fit_model) then fits
+//! the curves by least squares, and the model is refused if the model loader would refuse it.
 
 use super::CoverageIoError;
 use super::flight::fly_profile;
+use super::measurements::fit_usable_model;
 use super::profile::{Piece, Profile};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::path::PathBuf;
 use uavex_components::airframe::Airframe;
-use uavex_systems::coverage::{FitDegrees, FittedModel, Measurement, SpeedEnergyModel, fit_model};
+use uavex_systems::coverage::{FitDegrees, FittedModel, Measurement, SpeedEnergyModel};
 
 /// What to fly for a calibration.
 #[derive(Debug, Clone, PartialEq)]
@@ -151,10 +154,8 @@ pub fn calibrate(
         }));
         offset += end + 1.0;
     }
-    let fitted = fit_model(name, &log, plan.degrees).map_err(|source| CoverageIoError::Fit {
-        path: format!("calibration flights of {name}").into(),
-        source,
-    })?;
+    let data = PathBuf::from(format!("calibration flights of {name}"));
+    let fitted = fit_usable_model(name, &log, plan.degrees, &data)?;
     Ok(Calibration { log, fitted })
 }
 

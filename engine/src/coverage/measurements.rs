@@ -77,10 +77,32 @@ pub fn fit_measurements(
     degrees: FitDegrees,
 ) -> Result<FittedModel, CoverageIoError> {
     let rows = read_measurements(csv)?;
-    fit_model(name, &rows, degrees).map_err(|source| CoverageIoError::Fit {
-        path: csv.to_owned(),
+    fit_usable_model(name, &rows, degrees, csv)
+}
+
+/// Fits a model from `rows` (which came from `data`, named in errors) and refuses it right away
+/// if the model loader would: `SpeedEnergyModel::validate`, the check
+/// [`load_energy_model`](super::load_energy_model) applies to every model file. A least-squares
+/// curve may dip to non-positive power within the measured speeds; such a model would otherwise
+/// be written, and only refused when a mission used it.
+pub(crate) fn fit_usable_model(
+    name: &str,
+    rows: &[Measurement],
+    degrees: FitDegrees,
+    data: &Path,
+) -> Result<FittedModel, CoverageIoError> {
+    let fitted = fit_model(name, rows, degrees).map_err(|source| CoverageIoError::Fit {
+        path: data.to_owned(),
         source,
-    })
+    })?;
+    fitted
+        .model
+        .validate()
+        .map_err(|source| CoverageIoError::UnusableFit {
+            path: data.to_owned(),
+            source,
+        })?;
+    Ok(fitted)
 }
 
 /// Writes rows in the format [`read_measurements`] reads.
@@ -148,6 +170,63 @@ mod tests {
                 phase: Phase::Hover
             }]
         );
+    }
+
+    /// Rows of the IRIS model's experiments, with `cruise_drop` W per m/s taken off the level
+    /// flight's power.
+    fn iris_rows(cruise_drop: f64) -> Vec<Measurement> {
+        let iris = uavex_systems::coverage::SpeedEnergyModel::iris();
+        let mut rows = Vec::new();
+        let mut log = |speed: f64, power_w: f64, phase| {
+            let time_s = rows.len() as f64 * 0.1;
+            rows.push(Measurement {
+                time_s,
+                speed,
+                power_w,
+                phase,
+            });
+        };
+        for i in 0..=150 {
+            let v = i as f64 / 10.0;
+            log(v, iris.accelerating.power(v), Phase::Accelerate);
+        }
+        for i in 0..=150 {
+            let v = 15.0 - i as f64 / 10.0;
+            log(v, iris.decelerating.power(v), Phase::Decelerate);
+        }
+        for i in 0..=15 {
+            let v = i as f64;
+            log(v, iris.level.power(v) - cruise_drop * v, Phase::Cruise);
+        }
+        log(2.0, 249.0, Phase::Climb);
+        log(1.3, 212.0, Phase::Descend);
+        log(2.1, 225.0, Phase::Turn);
+        rows
+    }
+
+    /// A fit the model loader would refuse is refused when it is made, with the data file
+    /// named, not later when the model is used.
+    #[test]
+    fn a_fit_the_loader_would_refuse_is_refused_naming_the_data() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("log.csv");
+        write_measurements(&path, &iris_rows(0.0)).unwrap();
+        let fitted = fit_measurements(&path, "iris again", FitDegrees::default()).unwrap();
+        assert!(fitted.model.validate().is_ok());
+        // Level flight that costs 30 W less per m/s: negative power at 15 m/s, the top speed.
+        write_measurements(&path, &iris_rows(30.0)).unwrap();
+        let err = fit_measurements(&path, "sinking", FitDegrees::default())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with(&format!(
+                "{}: the model fitted from these measurements is unusable: energy model \
+                 `sinking`: level.coefficients give -",
+                path.display()
+            )),
+            "{err}"
+        );
+        assert!(err.contains("must be positive at every speed"), "{err}");
     }
 
     #[test]

@@ -32,9 +32,10 @@ pub use report::{cover_report, energy_report, fit_report};
 pub use scenario::{CoverageScenario, read_coverage_scenario};
 pub use spec::{AreaSpec, CoverageSetup, CoverageSpec};
 
+use crate::scenario::ScenarioErrors;
 use std::path::PathBuf;
 use thiserror::Error;
-use uavex_systems::coverage::{FitError, MissionError, PolygonError};
+use uavex_systems::coverage::{EnergyModelError, FitError, MissionError, PolygonError};
 
 /// Anything that goes wrong reading coverage inputs or writing coverage outputs, with the file.
 #[derive(Debug, Error)]
@@ -58,6 +59,13 @@ pub enum CoverageIoError {
     },
     #[error("{path}: cannot fit an energy model: {source}")]
     Fit { path: PathBuf, source: FitError },
+    /// The fit succeeded but gives a model the model loader refuses (power not positive over
+    /// the measured speeds, non-finite coefficients); `path` names the data it came from.
+    #[error("{path}: the model fitted from these measurements is unusable: {source}")]
+    UnusableFit {
+        path: PathBuf,
+        source: EnergyModelError,
+    },
     #[error("{path}: drawing failed: {message}")]
     Picture { path: PathBuf, message: String },
     #[error(transparent)]
@@ -66,6 +74,9 @@ pub enum CoverageIoError {
     /// named: the caller knows the scenario (`uavex cover` puts it in front).
     #[error("coverage {field}: {source}")]
     Plan { field: String, source: MissionError },
+    /// Problems of a scenario file, each at its line and field (`uavex cover`).
+    #[error(transparent)]
+    Scenario(#[from] ScenarioErrors),
     /// A simulated flight (calibration or flying a plan) failed.
     #[error("simulated flight: {0}")]
     Flight(String),

@@ -24,9 +24,10 @@ use super::report::cover_report;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
+use uavex_systems::coverage::path::MAX_SHOTS;
 use uavex_systems::coverage::{
-    AltitudeOutcome, AltitudeSearch, Camera, CameraError, CoverageProblem, MissionError, Overlaps,
-    PathError, Polygon, PolygonError, ScanDirection, SpeedEnergyModel, search_altitude,
+    AltitudeOutcome, AltitudeSearch, Camera, CameraError, CoverageProblem, Footprint, MissionError,
+    Overlaps, PathError, Polygon, PolygonError, ScanDirection, SpeedEnergyModel, search_altitude,
 };
 
 /// What a coverage mission surveys, with what, and on how much energy.
@@ -194,7 +195,7 @@ impl CoverageSetup {
             &self.search,
         )
         .map_err(|source| CoverageIoError::Plan {
-            field: mission_field(&source, &self.problem.camera).to_owned(),
+            field: mission_field(&source, &self.problem, &self.search).to_owned(),
             source,
         })
     }
@@ -251,13 +252,32 @@ fn camera_field(error: &CameraError, camera: &Camera) -> &'static str {
     }
 }
 
-/// The spec field a planning problem is about. Problems of size (too many photos, an area
-/// thinner than the tolerance) come from the area against the footprint; their messages give
-/// the spacings and what would shrink the count.
-fn mission_field(error: &MissionError, camera: &Camera) -> &'static str {
+/// The spec field a planning problem is about. A plan of too many photos is blamed on its cause
+/// ([`too_many_shots_field`]); the path's other problems (an area thinner than the tolerance,
+/// concavities nested too deep) are the area's.
+fn mission_field(
+    error: &MissionError,
+    problem: &CoverageProblem,
+    search: &AltitudeSearch,
+) -> &'static str {
     match error {
-        MissionError::Camera(e) => camera_field(e, camera),
+        MissionError::Camera(e) => camera_field(e, &problem.camera),
         MissionError::Path(PathError::StartVertex { .. }) => "start_vertex",
+        &MissionError::Path(PathError::TooManyShots {
+            altitude_m,
+            l_x,
+            l_y,
+            d_x,
+            d_y,
+            ..
+        }) => too_many_shots_field(
+            problem,
+            search,
+            altitude_m,
+            Footprint { l_x, l_y },
+            d_x,
+            d_y,
+        ),
         MissionError::Path(_) => "area",
         MissionError::EnergyModel(_) | MissionError::LegEnergy { .. } => "energy_model",
         MissionError::AvailableEnergy(_) | MissionError::FarBeyondBattery { .. } => {
@@ -267,6 +287,64 @@ fn mission_field(error: &MissionError, camera: &Camera) -> &'static str {
         MissionError::StepTooSmall { .. } | MissionError::TooManySteps { .. } => "altitude.step_m",
         MissionError::ResolutionUnreachable { .. } => "resolution_px_per_m",
     }
+}
+
+/// The spec field to blame for a plan at `altitude_m` of more than [`MAX_SHOTS`] photos and
+/// stripes, with footprint `l`, stripes `d_x` and photos `d_y` apart (the error's figures).
+///
+/// The planner's count is about `N(d_x, d_y) = A / (d_x d_y) + P / min(d_x, d_y)`: the photos
+/// over the area `A`, plus those along its border `P` and at the ends of the stripes. Besides
+/// the area itself, four settings shrink a spacing, each by a factor that is 1 at its plain
+/// value:
+/// - `overlap.x`: stripes `1 - overlap.x` of the footprint's width apart (plain: no overlap);
+/// - `overlap.y`: photos `1 - overlap.y` of the footprint's length apart (plain: no overlap);
+/// - the image's short side: `camera.height_px` for an image wider than tall (a footprint short
+///   along the track), else `camera.width_px` (narrow across it); its spacing shrinks by the
+///   aspect ratio (plain: a square image);
+/// - `altitude.min_altitude_m`, when the search went below `h_max` (the altitude of the required
+///   resolution) to spend spare energy: both spacings shrink by `h / h_max` (plain: flying at
+///   `h_max`).
+///
+/// The setting blamed is one whose plain value alone brings `N` within the limit, of several
+/// the one that brings it lowest. When none alone does (or `N` itself stays within the limit:
+/// a shape the estimate misses), the area is too large for the footprint the required
+/// resolution allows, and `area` is blamed.
+fn too_many_shots_field(
+    problem: &CoverageProblem,
+    search: &AltitudeSearch,
+    altitude_m: f64,
+    l: Footprint,
+    d_x: f64,
+    d_y: f64,
+) -> &'static str {
+    let area = problem.polygon.area();
+    let border = problem.polygon.perimeter();
+    let count = |d_x: f64, d_y: f64| area / (d_x * d_y) + border / d_x.min(d_y);
+    let limit = MAX_SHOTS as f64;
+    let estimate = count(d_x, d_y);
+    if estimate.is_nan() || estimate <= limit {
+        return "area";
+    }
+    let mut plain = vec![("overlap.x", l.l_x, d_y), ("overlap.y", d_x, l.l_y)];
+    if l.l_y < l.l_x {
+        plain.push(("camera.height_px", d_x, d_y * l.l_x / l.l_y));
+    } else if l.l_x < l.l_y {
+        plain.push(("camera.width_px", d_x * l.l_y / l.l_x, d_y));
+    }
+    let h_max = problem
+        .camera
+        .max_altitude(problem.required_resolution_px_per_m)
+        .map_or(altitude_m, |h| h.min(search.max_altitude_m));
+    if altitude_m < h_max {
+        let scale = h_max / altitude_m;
+        plain.push(("altitude.min_altitude_m", d_x * scale, d_y * scale));
+    }
+    plain
+        .into_iter()
+        .map(|(field, d_x, d_y)| (field, count(d_x, d_y)))
+        .filter(|&(_, n)| n <= limit)
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or("area", |(field, _)| field)
 }
 
 #[cfg(test)]
@@ -454,12 +532,66 @@ mod tests {
                 .unwrap_err()
                 .to_string()
         };
-        let err = plan(&SPEC.replace("y = 0.3", "y = 0.999999999"));
-        assert!(err.starts_with("coverage area: covering the area"), "{err}");
         let err = plan(&SPEC.replace(
             "altitude = { step_m = 0.5 }",
             "altitude = { step_m = 1e-30, min_altitude_m = 10.0, max_altitude_m = 10.0 }",
         ));
         assert!(err.starts_with("coverage altitude.step_m: "), "{err}");
+    }
+
+    /// A plan of more than `MAX_SHOTS` photos blames the setting that alone makes it so (see
+    /// `too_many_shots_field`), and the message keeps the spacings.
+    #[test]
+    fn too_many_photos_blame_their_cause() {
+        let plan = |text: &str| {
+            toml::from_str::<CoverageSpec>(text)
+                .unwrap()
+                .resolve(Path::new("."), Path::new("s.toml"))
+                .unwrap()
+                .plan()
+                .unwrap_err()
+                .to_string()
+        };
+        let blamed = |err: &str, field: &str| {
+            assert!(
+                err.starts_with(&format!("coverage {field}: covering the area at ")),
+                "{field}: {err}"
+            );
+            assert!(
+                err.contains("stripes come") && err.contains("photos along a stripe"),
+                "{err}"
+            );
+        };
+        // Photos 3e-8 m apart along the stripes: the overlap along the track.
+        blamed(
+            &plan(&SPEC.replace("y = 0.3", "y = 0.999999999")),
+            "overlap.y",
+        );
+        // Stripes 4e-5 m apart.
+        blamed(&plan(&SPEC.replace("x = 0.2", "x = 0.999999")), "overlap.x");
+        // A 4000 x 1 px image at 400 px/m: a footprint 10 m wide and 2.5 mm long.
+        let wide = SPEC
+            .replace("height_px = 3000", "height_px = 1")
+            .replace("resolution_px_per_m = 100.0", "resolution_px_per_m = 400.0")
+            .replace("step_m = 0.5", "step_m = 0.5, min_altitude_m = 1.0");
+        blamed(&plan(&wide), "camera.height_px");
+        // A 1 x 3000 px image at 200 px/m: 5 mm wide, 15 m long.
+        let tall = SPEC
+            .replace("width_px = 4000", "width_px = 1")
+            .replace("resolution_px_per_m = 100.0", "resolution_px_per_m = 200.0")
+            .replace("step_m = 0.5", "step_m = 0.5, min_altitude_m = 0.001");
+        blamed(&plan(&tall), "camera.width_px");
+        // Plain settings over 300 km x 150 km: the area itself.
+        let huge = SPEC.replace(
+            "[[0, 0], [0, 150], [300, 150], [300, 0]]",
+            "[[0, 0], [0, 150000], [300000, 150000], [300000, 0]]",
+        );
+        blamed(&plan(&huge), "area");
+        // Feasible at h_max = 20 m with energy to spare, the search goes down to 0.1 m, where
+        // the footprint is 200 times smaller on each side.
+        let low = SPEC
+            .replace("available_energy_j = 200000.0", "available_energy_j = 1e12")
+            .replace("step_m = 0.5", "step_m = 19.9, min_altitude_m = 0.1");
+        blamed(&plan(&low), "altitude.min_altitude_m");
     }
 }

@@ -16,6 +16,7 @@ mod check;
 mod de;
 mod decode;
 mod diagnostic;
+mod document;
 mod path;
 pub mod schema;
 mod source_map;
@@ -32,6 +33,8 @@ pub use diagnostic::{Diagnostic, ScenarioErrors};
 pub use path::{FieldPath, Segment};
 pub use schema::*;
 pub use source_map::{Anchor, Location, SourceMap};
+
+pub(crate) use document::Document;
 
 use diagnostic::Finding;
 
@@ -61,8 +64,7 @@ impl LoadedScenario {
     /// (`"world.obstacle[3].file"`, `"mesh file not found: ..."`) or a geometry check
     /// (`"uav[0].start.position"`, `"starts inside obstacle 'pillar 1'"`).
     pub fn diagnostic(&self, field_path: &str, message: impl Into<String>) -> Diagnostic {
-        Finding::new(FieldPath::parse(field_path), Anchor::Value, message)
-            .locate(&self.path, &self.source)
+        self.source.diagnostic(&self.path, field_path, message)
     }
 
     /// The located errors for a list of `(field path, message)` problems, for merging the
@@ -89,6 +91,12 @@ impl LoadedScenario {
 /// Reads, decodes and checks the scenario file at `path`.
 pub fn load(path: impl AsRef<Path>) -> Result<LoadedScenario, ScenarioErrors> {
     let path = path.as_ref();
+    parse_str(&read_text(path)?, path)
+}
+
+/// The text of the scenario file at `path`, refused (with the place, for text that is not
+/// UTF-8) when it cannot be read.
+fn read_text(path: &Path) -> Result<String, ScenarioErrors> {
     let whole_file = |message: String, line: usize, column: usize| ScenarioErrors {
         diagnostics: vec![Diagnostic {
             file: path.to_owned(),
@@ -102,7 +110,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<LoadedScenario, ScenarioErrors> {
     };
     let bytes = std::fs::read(path)
         .map_err(|error| whole_file(format!("cannot read the scenario file: {error}"), 0, 0))?;
-    let text = String::from_utf8(bytes).map_err(|error| {
+    String::from_utf8(bytes).map_err(|error| {
         let valid = error.utf8_error().valid_up_to();
         let prefix = String::from_utf8_lossy(&error.as_bytes()[..valid]).into_owned();
         let at = SourceMap::lines_only(&prefix).location_of_offset(valid);
@@ -111,8 +119,7 @@ pub fn load(path: impl AsRef<Path>) -> Result<LoadedScenario, ScenarioErrors> {
             at.line,
             at.column,
         )
-    })?;
-    parse_str(&text, path)
+    })
 }
 
 /// Decodes and checks scenario `text`; `path` names it in messages and gives the base folder.
@@ -122,33 +129,12 @@ pub fn parse_str(text: &str, path: impl AsRef<Path>) -> Result<LoadedScenario, S
         Some(parent) if !parent.as_os_str().is_empty() => parent.to_owned(),
         _ => PathBuf::from("."),
     };
-    let tree = match tree::parse_document(text) {
-        Ok(tree) => tree,
-        Err(errors) => {
-            let source = SourceMap::lines_only(text);
-            let diagnostics = errors
-                .into_iter()
-                .map(|error| {
-                    let at = source.location_of_offset(error.span.start);
-                    Diagnostic {
-                        file: path.clone(),
-                        line: at.line,
-                        column: at.column,
-                        path: String::new(),
-                        message: format!("TOML syntax: {}", error.message),
-                        expected: Some("valid TOML".to_owned()),
-                        found: None,
-                    }
-                })
-                .collect();
-            return Err(ScenarioErrors { diagnostics });
-        }
-    };
+    let tree = parse_tree(text, &path)?;
     let source = SourceMap::new(text, &tree);
 
     let mut structure = Vec::new();
     let decoded = decode::decode(&tree, &mut structure);
-    structure.extend(decode::non_finite(&tree));
+    structure.extend(decode::non_finite(&tree, &FieldPath::root()));
     let semantic = check::check_parts(&check::Parts::of_decoded(&decoded));
 
     let mut diagnostics = in_file_order(structure, &path, &source);
@@ -176,6 +162,29 @@ pub fn parse_str(text: &str, path: impl AsRef<Path>) -> Result<LoadedScenario, S
             }],
         }),
     }
+}
+
+/// The tree of scenario `text` (named `path` in messages), or every TOML syntax error in it.
+fn parse_tree(text: &str, path: &Path) -> Result<tree::Node, ScenarioErrors> {
+    tree::parse_document(text).map_err(|errors| {
+        let source = SourceMap::lines_only(text);
+        let diagnostics = errors
+            .into_iter()
+            .map(|error| {
+                let at = source.location_of_offset(error.span.start);
+                Diagnostic {
+                    file: path.to_owned(),
+                    line: at.line,
+                    column: at.column,
+                    path: String::new(),
+                    message: format!("TOML syntax: {}", error.message),
+                    expected: Some("valid TOML".to_owned()),
+                    found: None,
+                }
+            })
+            .collect();
+        ScenarioErrors { diagnostics }
+    })
 }
 
 /// Locates findings and sorts them by place (stable, so same-place findings keep their order),

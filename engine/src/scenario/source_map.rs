@@ -3,7 +3,9 @@
 //! shown at its line and column.
 
 use std::collections::HashMap;
+use std::path::Path;
 
+use super::diagnostic::{Diagnostic, Finding};
 use super::path::FieldPath;
 use super::tree::{Node, Span};
 
@@ -23,14 +25,14 @@ pub enum Anchor {
     Value,
 }
 
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 struct Spans {
     key: Option<Span>,
     value: Span,
 }
 
 /// Spans of every value of one scenario text, by field path.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct SourceMap {
     text: String,
     line_starts: Vec<usize>,
@@ -116,6 +118,17 @@ impl SourceMap {
             at = current.parent();
         }
         Location { line: 1, column: 1 }
+    }
+
+    /// A diagnostic for a problem of the file `file` (the one this maps) found after loading,
+    /// by whoever only knows its field path (`uav[0].behaviour.overlap.y`), shown at the value.
+    pub fn diagnostic(
+        &self,
+        file: &Path,
+        field_path: &str,
+        message: impl Into<String>,
+    ) -> Diagnostic {
+        Finding::new(FieldPath::parse(field_path), Anchor::Value, message).locate(file, self)
     }
 
     /// Whether the file writes a value at `path`.

@@ -15,7 +15,7 @@
 use super::primitives::upright_cylinder;
 use super::{BuildError, display_name, require_finite, require_positive};
 use crate::scenario::ObstacleSpec;
-use glam::{Vec2, Vec3};
+use glam::{DVec2, Vec2, Vec3};
 use rand::Rng;
 use rand_distr::{Distribution, Poisson};
 use uavex_components::sim::{RunSeed, stream};
@@ -80,6 +80,125 @@ fn distance_to_pillar(point: Vec3, pillar: &Pillar, height: f32) -> f32 {
     let radial = (point.truncate().distance(pillar.base) - pillar.radius).max(0.0);
     let vertical = (point.z - height).max(-point.z).max(0.0);
     radial.hypot(vertical)
+}
+
+/// Most starts [`room_for_pillars`] examines exactly (it tries O(n^2) points against n discs);
+/// with more UAVs near a field it assumes there is room.
+const MAX_STARTS_EXAMINED: usize = 256;
+
+/// Whether a pillar of `radius` can stand somewhere in `field`'s region at least
+/// `start_clearance` from every start, i.e. survive [`generate_pillars`]'s removal.
+///
+/// Seen from above, a start removes exactly the bases within `radius + sqrt(c^2 - v^2)` of it
+/// (`c` the clearance, `v` the start's height above the pillar tops or below their feet; none
+/// when `v >= c`), an open disc. What is left of the region is closed, and if not empty its
+/// lowest-x, then lowest-y point is a corner of the region, a crossing of a disc's rim with an
+/// edge of the region, or a crossing of two rims: those points are tried. A point left on a
+/// rim by rounding counts as free, so only a region certainly covered is reported as such.
+fn room_for_pillars(field: &PillarField, radius: f32, starts: &[Vec3]) -> bool {
+    let (lo, hi) = (field.region_min.as_dvec2(), field.region_max.as_dvec2());
+    let clearance = f64::from(field.start_clearance);
+    let height = f64::from(field.height);
+    let discs: Vec<(DVec2, f64)> = starts
+        .iter()
+        .filter_map(|start| {
+            let start = start.as_dvec3();
+            let v = (start.z - height).max(-start.z).max(0.0);
+            let reach = f64::from(radius) + (clearance * clearance - v * v).max(0.0).sqrt();
+            let centre = start.truncate();
+            // Only discs that reach into the region matter.
+            let nearest = centre.clamp(lo, hi);
+            (v < clearance && nearest.distance(centre) < reach).then_some((centre, reach))
+        })
+        .collect();
+    if discs.len() > MAX_STARTS_EXAMINED {
+        return true;
+    }
+    let tolerance = 1e-9 * (hi - lo).max_element().max(clearance);
+    let free = |p: DVec2| {
+        p.cmpge(lo - tolerance).all()
+            && p.cmple(hi + tolerance).all()
+            && discs
+                .iter()
+                .all(|&(centre, reach)| p.distance(centre) >= reach - tolerance)
+    };
+    let corners = [lo, DVec2::new(hi.x, lo.y), hi, DVec2::new(lo.x, hi.y)];
+    if corners.into_iter().any(free) {
+        return true;
+    }
+    for (i, &(a, ra)) in discs.iter().enumerate() {
+        for x in [lo.x, hi.x] {
+            let dy = (ra * ra - (x - a.x).powi(2)).max(0.0).sqrt();
+            if [a.y - dy, a.y + dy]
+                .into_iter()
+                .any(|y| free(DVec2::new(x, y)))
+            {
+                return true;
+            }
+        }
+        for y in [lo.y, hi.y] {
+            let dx = (ra * ra - (y - a.y).powi(2)).max(0.0).sqrt();
+            if [a.x - dx, a.x + dx]
+                .into_iter()
+                .any(|x| free(DVec2::new(x, y)))
+            {
+                return true;
+            }
+        }
+        for &(b, rb) in &discs[i + 1..] {
+            if rim_crossings(a, ra, b, rb).into_iter().flatten().any(free) {
+                return true;
+            }
+        }
+    }
+    false
+}
+
+/// Where the circles of radius `ra` about `a` and `rb` about `b` cross (none when they do not
+/// meet or share a centre).
+fn rim_crossings(a: DVec2, ra: f64, b: DVec2, rb: f64) -> [Option<DVec2>; 2] {
+    let d = a.distance(b);
+    if d == 0.0 || d > ra + rb || d < (ra - rb).abs() {
+        return [None, None];
+    }
+    let along = (d * d + ra * ra - rb * rb) / (2.0 * d);
+    let across = (ra * ra - along * along).max(0.0).sqrt();
+    let u = (b - a) / d;
+    let mid = a + u * along;
+    let perp = u.perp() * across;
+    [Some(mid + perp), Some(mid - perp)]
+}
+
+/// The error for a field [`room_for_pillars`] finds no room in, at its cause: the clearance
+/// when it alone covers the region (no pillar, however thin, could stand), else the smallest
+/// radius (thin pillars could, but the field draws none thinner than `radius_min`; its
+/// `radius_max` removes only some, as radii are drawn down to `radius_min`).
+fn cleared_field(field: &PillarField, field_path: &str, starts: &[Vec3]) -> BuildError {
+    let region = format!(
+        "[{}, {}] to [{}, {}]",
+        field.region_min.x, field.region_min.y, field.region_max.x, field.region_max.y
+    );
+    if room_for_pillars(field, 0.0, starts) {
+        BuildError::new(
+            format!("{field_path}.radius_min"),
+            format!(
+                "must leave room for pillars: no pillar of radius {} m or more fits anywhere in \
+                 the region {region} at least start_clearance ({} m) from the UAV starts, so \
+                 every pillar of the region would be removed (for no pillars, set density = 0)",
+                field.radius_min, field.start_clearance
+            ),
+        )
+    } else {
+        BuildError::new(
+            format!("{field_path}.start_clearance"),
+            format!(
+                "must leave room for pillars: {} m around the UAV starts covers the whole region \
+                 {region}, so every pillar of the region would be removed (for no pillars, set \
+                 density = 0)",
+                field.start_clearance
+            ),
+        )
+    }
 }
 
 /// The pillars of the generator at `world.obstacle[index]`, as obstacles named `"{name} #{k}"`.
@@ -161,6 +280,14 @@ pub(super) fn build(
         height: *height as f32,
         start_clearance: *start_clearance as f32,
     };
+    // A field that asks for pillars (density > 0) yet can hold none, because the clearance
+    // around the starts removes every one wherever it is drawn, is almost surely a mistake (a
+    // clearance meant in decimetres, a region placed around the start), and its runs would
+    // silently fly an empty world. It is refused whatever the seed, as it holds for every draw.
+    // A density of 0 asks for no pillars (a study's obstacle-free baseline) and stays allowed.
+    if *density > 0.0 && !room_for_pillars(&field, field.radius_min, starts) {
+        return Err(vec![cleared_field(&field, field_path, starts)]);
+    }
     let mut rng = seed.stream(stream::WORLD_GENERATOR, index as u64);
     let base_name = display_name(name, "pillars", index);
     Ok(generate_pillars(&field, starts, &mut rng)
@@ -300,6 +427,73 @@ mod tests {
             ..FIELD
         };
         assert!(draw(1, &none, &[START]).is_empty());
+    }
+
+    /// The errors of a world with one pillar field (`extra` added to its table) for UAVs
+    /// starting at `starts`; none when it builds.
+    fn field_errors(extra: &str, starts: &[Vec3]) -> Vec<BuildError> {
+        let spec: WorldSpec = toml::from_str(&format!(
+            r#"
+            bounds = {{ min = [-10, -10, 0], max = [10, 10, 3] }}
+            [[obstacle]]
+            kind = "pillars"
+            region_min = [-2, -2]
+            region_max = [2, 2]
+            height = 3
+            {extra}
+            "#
+        ))
+        .unwrap();
+        super::super::build_world(&spec, RunSeed(0), starts, Path::new("."))
+            .err()
+            .unwrap_or_default()
+    }
+
+    #[test]
+    fn a_field_whose_every_pillar_would_be_removed_is_refused() {
+        let field = |extra: &str| format!("density = 0.5\nradius_min = 0.1\n{extra}");
+        // The region's far corners are 2.83 m from a start at its centre.
+        let errors = field_errors(&field("radius_max = 0.2\nstart_clearance = 3.0"), &[START]);
+        assert_eq!(errors.len(), 1, "{errors:?}");
+        assert_eq!(errors[0].path, "world.obstacle[0].start_clearance");
+        assert!(
+            errors[0]
+                .message
+                .contains("every pillar of the region would be removed"),
+            "{}",
+            errors[0]
+        );
+        // A clearance that leaves the corners free for thin pillars, but not for pillars of
+        // at least 0.5 m: their radius is the cause.
+        let errors = field_errors(
+            &field("radius_max = 0.6\nstart_clearance = 2.5").replace("0.1", "0.5"),
+            &[START],
+        );
+        assert_eq!(errors.len(), 1, "{errors:?}");
+        assert_eq!(errors[0].path, "world.obstacle[0].radius_min");
+        // radius_max alone removes only some: thin pillars still stand in the corners.
+        assert!(
+            field_errors(&field("radius_max = 0.6\nstart_clearance = 2.5"), &[START]).is_empty()
+        );
+        // Two starts whose clearances cover the region only together: the points farthest
+        // from both, (0, -2) and (0, 2), are 2.83 m from each.
+        let pair = [Vec3::new(-2.0, 0.0, 1.0), Vec3::new(2.0, 0.0, 1.0)];
+        let errors = field_errors(&field("radius_max = 0.1\nstart_clearance = 2.9"), &pair);
+        assert_eq!(errors.len(), 1, "{errors:?}");
+        assert_eq!(errors[0].path, "world.obstacle[0].start_clearance");
+        // ... and with a gap between them there (each clears 1.9 m around it).
+        assert!(field_errors(&field("radius_max = 0.1\nstart_clearance = 1.8"), &pair).is_empty());
+        // A start high above the pillars is farther from them than its horizontal distance.
+        let high = [Vec3::new(0.0, 0.0, 5.5)];
+        assert!(field_errors(&field("radius_max = 0.1\nstart_clearance = 3.0"), &high).is_empty());
+        // No pillars asked for (density 0, e.g. a study's baseline): nothing to remove.
+        assert!(
+            field_errors(
+                "density = 0.0\nradius_min = 0.1\nradius_max = 0.2\nstart_clearance = 30.0",
+                &[START]
+            )
+            .is_empty()
+        );
     }
 
     #[test]

@@ -136,6 +136,7 @@ pub(crate) fn check_parts(parts: &Parts<'_>) -> Vec<Finding> {
         parts.map,
         parts.bounds,
         parts.root.map(|root| root.physics_rate_hz),
+        parts.root.map(|root| root.world.ground),
     );
     if let Some(root) = parts.root {
         world::check_run(root, &mut out);

@@ -413,6 +413,36 @@ fn uav_settings() {
 }
 
 #[test]
+fn a_start_below_the_ground_is_refused() {
+    // Bounds that reach below the floor let a start there pass the bounds check; below the
+    // ground slab (1 m thick) no obstacle check sees it either.
+    let deep = with("min = [0.0, 0.0, 0.0]", "min = [0.0, 0.0, -5.0]");
+    let below = deep.replace("[1.0, 1.0, 1.0] }", "[1.0, 1.0, -3.0] }");
+    assert_eq!(
+        one(&below),
+        finding(
+            "uav[0].start.position",
+            "must be at or above the ground, z >= 0 (world.ground = true lays a solid floor \
+             at z = 0)",
+            "[1.0, 1.0, -3.0]"
+        )
+    );
+    // Without the ground the same start is fine, and so is one on the floor with it.
+    let no_ground = below.replace("[world.bounds]", "[world]\nground = false\n[world.bounds]");
+    assert_eq!(findings(&no_ground), vec![]);
+    assert_eq!(
+        findings(&deep.replace("[1.0, 1.0, 1.0] }", "[1.0, 1.0, 0.0] }")),
+        vec![]
+    );
+    // A start outside the bounds is reported once, as outside them.
+    let (_, message, _) = one(&below.replace("-5.0]", "-1.0]"));
+    assert!(
+        message.starts_with("must be inside world.bounds"),
+        "{message}"
+    );
+}
+
+#[test]
 fn uav_set() {
     let second = format!(
         "{BASE}\n[[uav]]\nname = \"a\"\nstart = {{ position = [2.0, 2.0, 1.0] }}\nbehaviour = {{ kind = \"scripted\", speed = 1.0, waypoints = [[1.0, 1.0, 1.0]] }}\n"

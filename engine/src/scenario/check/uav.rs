@@ -111,13 +111,23 @@ pub(crate) fn check_uav(
                 .expected(format!("one of: {known}")),
         );
     }
+    let start = uav.start.position;
     if let Some(bounds) = &context.bounds
-        && !inside(uav.start.position, bounds.min, bounds.max)
+        && !inside(start, bounds.min, bounds.max)
     {
         out.push(Finding::must_be(
             path.key("start").key("position"),
             within(bounds),
-            triple(uav.start.position),
+            triple(start),
+        ));
+    } else if context.ground == Some(true) && start[2] < 0.0 {
+        // Bounds may reach below the floor (to map what lies under it); a UAV cannot start
+        // there. Inside the 1 m ground slab the world builder finds it in an obstacle, but
+        // deeper down nothing else would: the run would fly, or fall, under the ground plane.
+        out.push(Finding::must_be(
+            path.key("start").key("position"),
+            "at or above the ground, z >= 0 (world.ground = true lays a solid floor at z = 0)",
+            triple(start),
         ));
     }
     check_behaviour(&path.key("behaviour"), &uav.behaviour, context, out);

@@ -19,6 +19,8 @@ pub(crate) struct Context {
     pub map: Option<MapSpec>,
     /// The physics rate (Hz), when the top level decoded and the rate is valid.
     pub physics_rate_hz: Option<f64>,
+    /// `world.ground`, when the top level decoded.
+    pub ground: Option<bool>,
 }
 
 impl Context {
@@ -26,6 +28,7 @@ impl Context {
         map: Option<&MapSpec>,
         bounds: Option<&BoundsSpec>,
         physics_rate_hz: Option<f64>,
+        ground: Option<bool>,
     ) -> Self {
         let bounds = bounds.filter(|b| {
             (0..3).all(|k| usable(b.min[k]) && usable(b.max[k]) && b.min[k] < b.max[k])
@@ -36,6 +39,7 @@ impl Context {
             map: map.cloned(),
             physics_rate_hz: physics_rate_hz
                 .filter(|r| r.is_finite() && *r >= super::MIN_PHYSICS_RATE_HZ),
+            ground,
         }
     }
 }

@@ -5,7 +5,7 @@ use serde::de::DeserializeOwned;
 use super::try_decode;
 use crate::scenario::de::{DeError, DeErrorKind};
 use crate::scenario::path::{FieldPath, Segment};
-use crate::scenario::tree::{Node, Value};
+use crate::scenario::tree::{Entry, Node, Value};
 
 /// Trial decodings spent locating one problem (see `blame`); a bisection needs about
 /// log2(values) per level, so this is only reached by absurd files.
@@ -48,6 +48,12 @@ pub(super) fn locate<T: DeserializeOwned>(
 /// The table a missing field belongs to. serde names it, except inside a `kind` table, whose
 /// buffered content names the `kind` table for a field missing in a table nested in it (an
 /// empty `energy_budget = {}`): then the nested table that brings the problem in, if any.
+///
+/// `blame` may descend below that table, into its values (in `overlap = { x = 0.2 }`, keeping
+/// none of them makes `x` the missing field instead of `y`, so `x` looks like the culprit), or
+/// into the value before a field missing from the `kind` table itself (`camera = {...}` before a
+/// missing `overlap`). So the tables from the culprit up are asked, by [`owns_field`], whether
+/// the field is one of theirs; the nearest that says so is the one, else the `kind` table.
 pub(super) fn locate_missing<T: DeserializeOwned>(
     node: &Node,
     root: &FieldPath,
@@ -58,15 +64,66 @@ pub(super) fn locate_missing<T: DeserializeOwned>(
         .strip_prefix(root)
         .and_then(|rel| node.get(rel))
         .is_some_and(|table| table.get(&[key("kind")]).is_some());
+    let DeErrorKind::MissingField { field } = &error.kind else {
+        return at.clone();
+    };
     if !is_kind_table {
         return at.clone();
     }
-    let culprit = blame::<T>(node, root, at, error);
-    let nested_table = culprit
-        .strip_prefix(root)
-        .and_then(|rel| node.get(rel))
-        .is_some_and(|value| matches!(value.value, Value::Table(_)));
-    if nested_table { culprit } else { at.clone() }
+    let mut candidate = Some(blame::<T>(node, root, at, error));
+    while let Some(path) = candidate {
+        if path == *at || !path.starts_with(at) {
+            break;
+        }
+        if owns_field::<T>(node, root, &path, field) {
+            return path;
+        }
+        candidate = path.parent();
+    }
+    at.clone()
+}
+
+/// Key of the probe [`owns_field`] adds: no field of any table is called so.
+const PROBE_KEY: &str = "\u{0}probe";
+
+/// Whether `field` is a field of the table at `table` (lacking it): a key no table knows, added
+/// to it, makes serde refuse the key with the table's valid names, whatever the place it then
+/// names. Tables that take any key (maps) own no missing field.
+fn owns_field<T: DeserializeOwned>(
+    node: &Node,
+    root: &FieldPath,
+    table: &FieldPath,
+    field: &str,
+) -> bool {
+    let Some(relative) = table.strip_prefix(root) else {
+        return false;
+    };
+    let mut trial = node.clone();
+    let Some(Node {
+        span,
+        value: Value::Table(entries),
+    }) = trial.get_mut(relative)
+    else {
+        return false;
+    };
+    if entries.iter().any(|entry| entry.key == field) {
+        return false;
+    }
+    entries.push(Entry {
+        key: PROBE_KEY.to_owned(),
+        key_span: span.end..span.end,
+        node: Node {
+            span: span.end..span.end,
+            value: Value::Boolean(true),
+        },
+    });
+    matches!(
+        try_decode::<T>(&trial, root),
+        Err(DeError {
+            kind: DeErrorKind::UnknownField { field: probe, expected },
+            ..
+        }) if probe == PROBE_KEY && expected.contains(&field)
+    )
 }
 
 fn key(name: &str) -> Segment {
@@ -254,6 +311,17 @@ mod tests {
             )),
             "uav[0].behaviour.energy_budget"
         );
+        // A field missing from a nested table is the table's, although serde only names the
+        // behaviour and the search for its culprit goes down into the table's values.
+        let coverage = "kind = \"coverage\"\narea = { vertices = [[0, 0], [1, 0], [0, 1]] }\n";
+        assert_eq!(
+            culprit(&format!("{coverage}overlap = {{ x = 0.2 }}\n")),
+            "uav[0].behaviour.overlap"
+        );
+        // ... but a field missing after a table is not that table's.
+        let camera = "camera = { angle_of_view = 1.0, width_px = 4, height_px = 3, \
+                      shot_period_s = 1.0 }\n";
+        assert_eq!(culprit(&format!("{coverage}{camera}")), "uav[0].behaviour");
         // A field missing from the behaviour itself, and an unknown kind, stay where they were.
         assert_eq!(culprit(explore), "uav[0].behaviour");
         assert_eq!(culprit("kind = \"hover\"\n"), "uav[0].behaviour.kind");

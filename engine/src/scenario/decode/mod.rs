@@ -163,7 +163,7 @@ pub(super) fn try_decode<T: DeserializeOwned>(node: &Node, root: &FieldPath) -> 
 }
 
 /// Decodes one unit (`node`, found at `root`), reporting every problem it can.
-fn decode_unit<T: DeserializeOwned>(
+pub(super) fn decode_unit<T: DeserializeOwned>(
     mut node: Node,
     root: &FieldPath,
     findings: &mut Vec<Finding>,
@@ -218,10 +218,10 @@ fn decode_unit<T: DeserializeOwned>(
 
 /// Every number in the file that no quantity of a scenario can take (`nan`, `inf`, a literal too
 /// large for 64 bits, or one beyond the 32-bit floats of the geometry:
-/// [`crate::scenario::check::unusable_number`]).
-pub(crate) fn non_finite(tree: &Node) -> Vec<Finding> {
+/// [`crate::scenario::check::unusable_number`]) in `node`, found at `at`.
+pub(crate) fn non_finite(node: &Node, at: &FieldPath) -> Vec<Finding> {
     let mut findings = Vec::new();
-    tree.walk(&FieldPath::root(), &mut |path, node| {
+    node.walk(at, &mut |path, node| {
         if let Value::Float(x) = node.value {
             findings.extend(crate::scenario::check::unusable_number(path, x));
         }

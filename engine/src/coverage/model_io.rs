@@ -1,5 +1,6 @@
 //! Speed-based energy models by name: a preset (`iris`) or a model file, JSON or TOML, holding
-//! either a bare model or a fitted model with its fit report (as `fit` writes it).
+//! either a bare model or a fitted model with its fit report (as [`save_fitted_model`] writes
+//! it: `uavex calibrate`, or a fit of measured flights by [`super::fit_measurements`]).
 
 use super::CoverageIoError;
 use std::path::Path;

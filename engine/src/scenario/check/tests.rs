@@ -443,6 +443,23 @@ fn a_start_below_the_ground_is_refused() {
 }
 
 #[test]
+fn a_waypoint_below_the_ground_is_refused() {
+    let deep = with("min = [0.0, 0.0, 0.0]", "min = [0.0, 0.0, -5.0]");
+    let below = deep.replace("[[5.0, 5.0, 1.0]]", "[[5.0, 5.0, 1.0], [5.0, 5.0, -2.0]]");
+    assert_eq!(
+        one(&below),
+        finding(
+            "uav[0].behaviour.waypoints[1]",
+            "must be at or above the ground, z >= 0 (world.ground = true lays a solid floor \
+             at z = 0)",
+            "[5.0, 5.0, -2.0]"
+        )
+    );
+    let no_ground = below.replace("[world.bounds]", "[world]\nground = false\n[world.bounds]");
+    assert_eq!(findings(&no_ground), vec![]);
+}
+
+#[test]
 fn uav_set() {
     let second = format!(
         "{BASE}\n[[uav]]\nname = \"a\"\nstart = {{ position = [2.0, 2.0, 1.0] }}\nbehaviour = {{ kind = \"scripted\", speed = 1.0, waypoints = [[1.0, 1.0, 1.0]] }}\n"

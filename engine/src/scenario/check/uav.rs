@@ -111,25 +111,12 @@ pub(crate) fn check_uav(
                 .expected(format!("one of: {known}")),
         );
     }
-    let start = uav.start.position;
-    if let Some(bounds) = &context.bounds
-        && !inside(start, bounds.min, bounds.max)
-    {
-        out.push(Finding::must_be(
-            path.key("start").key("position"),
-            within(bounds),
-            triple(start),
-        ));
-    } else if context.ground == Some(true) && start[2] < 0.0 {
-        // Bounds may reach below the floor (to map what lies under it); a UAV cannot start
-        // there. Inside the 1 m ground slab the world builder finds it in an obstacle, but
-        // deeper down nothing else would: the run would fly, or fall, under the ground plane.
-        out.push(Finding::must_be(
-            path.key("start").key("position"),
-            "at or above the ground, z >= 0 (world.ground = true lays a solid floor at z = 0)",
-            triple(start),
-        ));
-    }
+    check_position(
+        path.key("start").key("position"),
+        uav.start.position,
+        context,
+        out,
+    );
     check_behaviour(&path.key("behaviour"), &uav.behaviour, context, out);
 }
 
@@ -216,16 +203,27 @@ fn check_waypoints(
             "an empty list",
         ));
     }
-    if let Some(bounds) = &context.bounds {
-        for (k, waypoint) in waypoints.iter().enumerate() {
-            if !inside(*waypoint, bounds.min, bounds.max) {
-                out.push(Finding::must_be(
-                    path.key("waypoints").index(k),
-                    within(bounds),
-                    triple(*waypoint),
-                ));
-            }
-        }
+    for (k, waypoint) in waypoints.iter().enumerate() {
+        check_position(path.key("waypoints").index(k), *waypoint, context, out);
+    }
+}
+
+/// A place a UAV is to be (its start, a waypoint): inside the map's bounds, and not under a
+/// `ground = true` floor. Bounds may reach below the floor (to map what lies under it), but a
+/// UAV cannot be there: inside the 1 m ground slab the world builder finds a start in an
+/// obstacle, deeper down nothing would, and the UAV would fly, or fall, under the ground plane
+/// (a waypoint there is one no flight can reach). Outside the bounds is said once, as such.
+fn check_position(at: FieldPath, position: [f64; 3], context: &Context, out: &mut Vec<Finding>) {
+    if let Some(bounds) = &context.bounds
+        && !inside(position, bounds.min, bounds.max)
+    {
+        out.push(Finding::must_be(at, within(bounds), triple(position)));
+    } else if context.ground == Some(true) && position[2] < 0.0 {
+        out.push(Finding::must_be(
+            at,
+            "at or above the ground, z >= 0 (world.ground = true lays a solid floor at z = 0)",
+            triple(position),
+        ));
     }
 }
 

@@ -3,7 +3,8 @@
 
 use std::fmt::Write;
 use uavex_systems::coverage::{
-    AltitudeOutcome, CurveFit, EnergyModelError, FittedModel, Polygon, SpeedEnergyModel, Verdict,
+    AltitudeOutcome, CurveFit, EnergyModelError, FittedModel, MAX_SHOTS, Polygon, SpeedEnergyModel,
+    Verdict,
 };
 
 /// `v*(d)`, `E(d, v*)` and `t(d)` of a straight leg of `distance` flown from rest to rest.
@@ -141,13 +142,17 @@ pub fn cover_report(
         margin / 1e3,
         100.0 * margin / outcome.available_energy_j
     );
-    let _ = writeln!(
+    let _ = write!(
         w,
         "  altitude search {} re-plans from {:.2} m to {:.2} m",
         outcome.trials.len(),
         outcome.trials.first().map_or(0.0, |t| t.altitude_m),
         outcome.trials.last().map_or(0.0, |t| t.altitude_m)
     );
+    let _ = match outcome.photo_limit_at_m {
+        Some(h) => writeln!(w, ", stopped at {h:.2} m: more than {MAX_SHOTS} photos"),
+        None => writeln!(w),
+    };
     out
 }
 

@@ -24,7 +24,7 @@ use super::report::cover_report;
 use glam::DVec2;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
-use uavex_systems::coverage::path::MAX_SHOTS;
+use uavex_systems::coverage::MAX_SHOTS;
 use uavex_systems::coverage::{
     AltitudeOutcome, AltitudeSearch, Camera, CameraError, CoverageProblem, Footprint, MissionError,
     Overlaps, PathError, Polygon, PolygonError, ScanDirection, SpeedEnergyModel, search_altitude,
@@ -195,7 +195,7 @@ impl CoverageSetup {
             &self.search,
         )
         .map_err(|source| CoverageIoError::Plan {
-            field: mission_field(&source, &self.problem, &self.search).to_owned(),
+            field: mission_field(&source, &self.problem).to_owned(),
             source,
         })
     }
@@ -255,29 +255,13 @@ fn camera_field(error: &CameraError, camera: &Camera) -> &'static str {
 /// The spec field a planning problem is about. A plan of too many photos is blamed on its cause
 /// ([`too_many_shots_field`]); the path's other problems (an area thinner than the tolerance,
 /// concavities nested too deep) are the area's.
-fn mission_field(
-    error: &MissionError,
-    problem: &CoverageProblem,
-    search: &AltitudeSearch,
-) -> &'static str {
+fn mission_field(error: &MissionError, problem: &CoverageProblem) -> &'static str {
     match error {
         MissionError::Camera(e) => camera_field(e, &problem.camera),
         MissionError::Path(PathError::StartVertex { .. }) => "start_vertex",
         &MissionError::Path(PathError::TooManyShots {
-            altitude_m,
-            l_x,
-            l_y,
-            d_x,
-            d_y,
-            ..
-        }) => too_many_shots_field(
-            problem,
-            search,
-            altitude_m,
-            Footprint { l_x, l_y },
-            d_x,
-            d_y,
-        ),
+            l_x, l_y, d_x, d_y, ..
+        }) => too_many_shots_field(problem, Footprint { l_x, l_y }, d_x, d_y),
         MissionError::Path(_) => "area",
         MissionError::EnergyModel(_) | MissionError::LegEnergy { .. } => "energy_model",
         MissionError::AvailableEnergy(_) | MissionError::FarBeyondBattery { .. } => {
@@ -289,8 +273,8 @@ fn mission_field(
     }
 }
 
-/// The spec field to blame for a plan at `altitude_m` of more than [`MAX_SHOTS`] photos and
-/// stripes, with footprint `l`, stripes `d_x` and photos `d_y` apart (the error's figures).
+/// The spec field to blame for a plan of more than [`MAX_SHOTS`] photos and stripes, with
+/// footprint `l`, stripes `d_x` and photos `d_y` apart (the error's figures).
 ///
 /// The planner's count is about `N(d_x, d_y) = A / (d_x d_y) + P / min(d_x, d_y)`: the photos
 /// over the area `A`, plus those along its border `P` and at the ends of the stripes. Besides
@@ -301,9 +285,10 @@ fn mission_field(
 /// - the image's short side: `camera.height_px` for an image wider than tall (a footprint short
 ///   along the track), else `camera.width_px` (narrow across it); its spacing shrinks by the
 ///   aspect ratio (plain: a square image);
-/// - `altitude.min_altitude_m`, when the search went below `h_max` (the altitude of the required
-///   resolution) to spend spare energy: both spacings shrink by `h / h_max` (plain: flying at
-///   `h_max`).
+///
+/// (The altitude is never to blame: the limit is met at `h_max`, the altitude of the required
+/// resolution, or the search ends there; lowering to spend spare energy stops at the limit,
+/// keeping the lowest plan above it.)
 ///
 /// The setting blamed is one whose plain value alone brings `N` within the limit, of several
 /// the one that brings it lowest. When none alone does (or `N` itself stays within the limit:
@@ -311,8 +296,6 @@ fn mission_field(
 /// resolution allows, and `area` is blamed.
 fn too_many_shots_field(
     problem: &CoverageProblem,
-    search: &AltitudeSearch,
-    altitude_m: f64,
     l: Footprint,
     d_x: f64,
     d_y: f64,
@@ -330,14 +313,6 @@ fn too_many_shots_field(
         plain.push(("camera.height_px", d_x, d_y * l.l_x / l.l_y));
     } else if l.l_x < l.l_y {
         plain.push(("camera.width_px", d_x * l.l_y / l.l_x, d_y));
-    }
-    let h_max = problem
-        .camera
-        .max_altitude(problem.required_resolution_px_per_m)
-        .map_or(altitude_m, |h| h.min(search.max_altitude_m));
-    if altitude_m < h_max {
-        let scale = h_max / altitude_m;
-        plain.push(("altitude.min_altitude_m", d_x * scale, d_y * scale));
     }
     plain
         .into_iter()
@@ -587,11 +562,23 @@ mod tests {
             "[[0, 0], [0, 150000], [300000, 150000], [300000, 0]]",
         );
         blamed(&plan(&huge), "area");
-        // Feasible at h_max = 20 m with energy to spare, the search goes down to 0.1 m, where
-        // the footprint is 200 times smaller on each side.
+        // Feasible at h_max = 20 m with energy to spare, the search would go down to 0.1 m,
+        // where the footprint is 200 times smaller on each side: it stops at the limit instead,
+        // and keeps the plan at 20 m.
         let low = SPEC
             .replace("available_energy_j = 200000.0", "available_energy_j = 1e12")
             .replace("step_m = 0.5", "step_m = 19.9, min_altitude_m = 0.1");
-        blamed(&plan(&low), "altitude.min_altitude_m");
+        let setup = toml::from_str::<CoverageSpec>(&low)
+            .unwrap()
+            .resolve(Path::new("."), Path::new("s.toml"))
+            .unwrap();
+        let outcome = setup.plan().unwrap();
+        assert_eq!(outcome.plan.survey.altitude_m, outcome.required_altitude_m);
+        assert!(outcome.photo_limit_at_m.is_some());
+        let report = setup.report(&outcome);
+        assert!(
+            report.contains("altitude search 1 re-plans from 20.00 m to 20.00 m, stopped at 0.10 m: more than 1000000 photos"),
+            "{report}"
+        );
     }
 }

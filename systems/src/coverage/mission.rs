@@ -301,6 +301,10 @@ pub struct AltitudeOutcome {
     pub required_altitude_m: f64,
     pub available_energy_j: f64,
     pub trials: Vec<AltitudeTrial>,
+    /// The altitude at which lowering stopped because the survey there would take more than
+    /// [`MAX_SHOTS`](super::path::MAX_SHOTS) photos (none when it did not stop there).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub photo_limit_at_m: Option<f64>,
 }
 
 /// Most re-plans of one altitude search (each a whole path).
@@ -315,10 +319,11 @@ pub const MIN_ALTITUDE_STEP_M: f64 = 1e-3;
 pub const MAX_FLIGHTS: u32 = 1_000_000;
 
 /// Plans at `h_max`; if feasible, lowers the altitude step by step (more resolution), re-planning
-/// and re-testing, until `E_tot` is within the tolerance below `E_available` or the minimum
-/// altitude is reached, and keeps the lowest feasible plan (energy against altitude is not
-/// monotonic, so an infeasible step does not end the search). If infeasible, raises the altitude
-/// when less resolution is acceptable, else reports the flights needed.
+/// and re-testing, until `E_tot` is within the tolerance below `E_available`, the minimum
+/// altitude is reached or the survey would take more photos than the planner allows, and keeps
+/// the lowest feasible plan (energy against altitude is not monotonic, so an infeasible step does
+/// not end the search). If infeasible, raises the altitude when less resolution is acceptable,
+/// else reports the flights needed.
 pub fn search_altitude(
     problem: &CoverageProblem,
     model: &SpeedEnergyModel,
@@ -382,6 +387,7 @@ pub fn search_altitude(
         Ok(plan)
     };
     let at_h_max = try_at(h_max)?;
+    let mut photo_limit_at_m = None;
     let (verdict, plan) = if at_h_max.is_feasible(available_j) {
         let mut best = at_h_max;
         // The loops run over step counts fixed up front, never over a float compared with a
@@ -390,7 +396,16 @@ pub fn search_altitude(
             if available_j - best.energy_j <= search.tolerance_j {
                 break;
             }
-            let plan = try_at(h)?;
+            let plan = match try_at(h) {
+                Ok(plan) => plan,
+                // A lower altitude has a smaller footprint, hence needs more photos still: no
+                // altitude below is plannable either. The lowest feasible plan above stands.
+                Err(MissionError::Path(PathError::TooManyShots { .. })) => {
+                    photo_limit_at_m = Some(h);
+                    break;
+                }
+                Err(e) => return Err(e),
+            };
             if plan.is_feasible(available_j) {
                 best = plan;
             }
@@ -423,6 +438,7 @@ pub fn search_altitude(
         required_altitude_m: h_max,
         available_energy_j: available_j,
         trials,
+        photo_limit_at_m,
     })
 }
 

@@ -121,6 +121,47 @@ fn spare_energy_buys_resolution() {
 }
 
 #[test]
+fn lowering_stops_at_the_photo_limit_and_keeps_the_lowest_plan_above() {
+    // 1000 px/m puts h_max at 2 m, where a photo covers 1.6 h x 1.05 h = 6.72 m^2 apart: the
+    // 1.8 km square takes about 0.5 M photos at 2 m, 0.9 M at 1.5 m and 2 M at 1 m, beyond
+    // the planner's limit of 1 M.
+    let side = 1800.0;
+    let square = Polygon::new(vec![
+        DVec2::new(0.0, 0.0),
+        DVec2::new(side, 0.0),
+        DVec2::new(side, side),
+        DVec2::new(0.0, side),
+    ])
+    .unwrap();
+    let p = CoverageProblem {
+        required_resolution_px_per_m: 1000.0,
+        ..problem(square)
+    };
+    let search = AltitudeSearch {
+        step_m: 0.5,
+        tolerance_j: 0.0,
+        min_altitude_m: 0.5,
+        max_altitude_m: 120.0,
+        accept_lower_resolution: false,
+    };
+    let outcome = search_altitude(&p, &SpeedEnergyModel::iris(), 1e12, &search).unwrap();
+    assert_eq!(outcome.verdict, Verdict::Feasible);
+    // h_max is 2 m to rounding (4000 px / (2 * 1000 px/m * tan 45 deg)).
+    let near = |h: f64, expected: f64| (h - expected).abs() < 1e-9;
+    let tried: Vec<f64> = outcome.trials.iter().map(|t| t.altitude_m).collect();
+    assert!(
+        tried.len() == 2 && near(tried[0], 2.0) && near(tried[1], 1.5),
+        "{tried:?}"
+    );
+    assert!(near(outcome.plan.survey.altitude_m, 1.5));
+    assert!(outcome.photo_limit_at_m.is_some_and(|h| near(h, 1.0)));
+    // The searches that never reach the limit say so.
+    let outcome =
+        search_altitude(&problem(field()), &SpeedEnergyModel::iris(), 1e12, &search).unwrap();
+    assert_eq!(outcome.photo_limit_at_m, None);
+}
+
+#[test]
 fn too_little_energy_is_infeasible_or_costs_resolution() {
     let iris = SpeedEnergyModel::iris();
     let p = problem(field());

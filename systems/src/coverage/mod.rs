@@ -35,6 +35,6 @@ pub use mission::{
     AltitudeOutcome, AltitudeSearch, AltitudeTrial, CoverageProblem, LegPlan, MissionError,
     MissionPlan, TurnPlan, Verdict, plan_mission, search_altitude,
 };
-pub use path::{CoveragePath, Leg, PathError, ScanDirection, Waypoint, plan_path};
+pub use path::{CoveragePath, Leg, MAX_SHOTS, PathError, ScanDirection, Waypoint, plan_path};
 pub use polygon::{Polygon, PolygonError};
 pub use power_curve::PowerCurve;

@@ -182,7 +182,7 @@ impl Voxel {
 ///
 /// **Row states.** The states of the voxels by x-row ([`Self::row_states`]), which frontiers
 /// and traversability read by the thousand, are kept as bits beside the voxels
-/// ([`ChunkCells`], [`super::rows`]): the map update sets a voxel's bits when it changes its
+/// ([`ChunkCells`], the `rows` module): the map update sets a voxel's bits when it changes its
 /// state; after a write through [`Self::voxels_mut`] rows are read from the voxels until the
 /// map update's next write rebuilds them.
 #[derive(Component, Debug, Clone)]
@@ -372,7 +372,7 @@ impl VoxelChunk {
     }
 
     /// The states of the voxels of row `row` (as [`Self::row_bits`]), kept as bits by the map
-    /// update ([`super::rows`]).
+    /// update (the `rows` module).
     #[inline]
     pub fn row_states(&self, row: usize) -> RowStates {
         if self.rows_stale {

@@ -5,7 +5,8 @@
 //! - [`camera`]: footprint, altitude from the required resolution, spacing, speed limit.
 //! - [`polygon`]: the surveyed area, validated.
 //! - [`path`]: the three-part back-and-forth with recursion into concavities (`sweep` cuts the
-//!   polygon into the cell a back-and-forth covers and the parts beyond it).
+//!   polygon into the cell a back-and-forth covers and the parts beyond it; `spacing` counts
+//!   and places the shots and stripes).
 //! - [`energy_model`]: the speed-based energy model ([`power_curve`] holds its polynomials), the
 //!   IRIS preset, `E(d, v)`, `t(d, v)` and `v*(d)`.
 //! - [`mission`]: the mission energy (eq. 18) of a plan, feasibility and the altitude search.
@@ -18,6 +19,7 @@ pub mod mission;
 pub mod path;
 pub mod polygon;
 pub mod power_curve;
+mod spacing;
 mod sweep;
 
 #[cfg(test)]

@@ -141,7 +141,7 @@ pub struct FreeBoxes {
     around: usize,
 }
 
-/// How many boxes a scan keeps: the three around the sensor and a chain of [`CHAIN`] beyond
+/// How many boxes a scan keeps: the three around the sensor and a chain of `CHAIN` beyond
 /// each of the first one's six faces.
 pub const MAX_FREE_BOXES: usize = 3 + 6 * CHAIN;
 
@@ -168,7 +168,7 @@ impl FreeBoxes {
     /// origin's brick is not full:
     /// - around the sensor, the box grown with all faces in turn, then those grown x first and
     ///   y first (each only if it differs from the ones before);
-    /// - beyond each face of the first one, a chain of [`CHAIN`] boxes, each grown with all
+    /// - beyond each face of the first one, a chain of `CHAIN` boxes, each grown with all
     ///   faces in turn from the brick just past the centre of the last one's face on that side
     ///   (see the module documentation).
     ///

@@ -3,7 +3,7 @@
 //! A decision fits a trajectory to every cluster along paths from one search tree: the paths
 //! to a cluster's centroid and viewpoints differ only near their ends, and paths to different
 //! clusters share their trunk near the UAV. The line-of-sight shortening of each path
-//! ([`super::search::shortcut_indices`]) therefore asks the same questions again and again:
+//! (`search::shortcut_indices`) therefore asks the same questions again and again:
 //! in the slowest replayed decisions of a Pillars mission, 7,800-10,100 line-of-sight tests of
 //! which 1,600-1,800 were distinct, 7-9 ms of a 18-21 ms planning pass. [`SightMemo`] answers
 //! a question it has seen from memory.

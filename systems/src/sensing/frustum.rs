@@ -93,7 +93,7 @@ pub struct RayTile {
 }
 
 impl RayTile {
-    /// The pattern's rays in tiles of [`TILE_EDGE`]^2, covering each ray once; none when some
+    /// The pattern's rays in tiles of `TILE_EDGE`^2, covering each ray once; none when some
     /// tile has no enclosing pyramid (rays that do not all look forward).
     pub fn tile(directions: &[Vec3], columns: usize, rows: usize) -> Vec<Self> {
         if columns * rows != directions.len() {

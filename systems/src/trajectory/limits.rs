@@ -229,7 +229,7 @@ impl Prepared {
 ///
 /// Why not the peaks of every segment: only the largest value decides (the ratio is monotonic
 /// in `|d|^2`), and most segments of a plan are far from binding. Each (segment, order) gets a
-/// cheap bound on its whole range first ([`segment_bound`]); they are grid-scanned largest
+/// cheap bound on its whole range first (`segment_bound`); they are grid-scanned largest
 /// bound first, until the bound cannot beat the ratio found so far (or `floor`). The bisection
 /// of each grid bracket costs as much as the grid, so a bracket too is refined only if the
 /// bound on its inside could beat the ratio found so far, largest bound first. A part skipped

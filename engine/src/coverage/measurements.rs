@@ -131,6 +131,39 @@ pub fn write_measurements(path: &Path, rows: &[Measurement]) -> Result<(), Cover
     })
 }
 
+/// Rows of the IRIS model's experiments, 0.1 s apart, with `cruise_drop` W per m/s taken off the
+/// level flight's power (test data of the coverage module's fits).
+#[cfg(test)]
+pub(crate) fn iris_rows(cruise_drop: f64) -> Vec<Measurement> {
+    let iris = uavex_systems::coverage::SpeedEnergyModel::iris();
+    let mut rows = Vec::new();
+    let mut log = |speed: f64, power_w: f64, phase| {
+        let time_s = rows.len() as f64 * 0.1;
+        rows.push(Measurement {
+            time_s,
+            speed,
+            power_w,
+            phase,
+        });
+    };
+    for i in 0..=150 {
+        let v = i as f64 / 10.0;
+        log(v, iris.accelerating.power(v), Phase::Accelerate);
+    }
+    for i in 0..=150 {
+        let v = 15.0 - i as f64 / 10.0;
+        log(v, iris.decelerating.power(v), Phase::Decelerate);
+    }
+    for i in 0..=15 {
+        let v = i as f64;
+        log(v, iris.level.power(v) - cruise_drop * v, Phase::Cruise);
+    }
+    log(2.0, 249.0, Phase::Climb);
+    log(1.3, 212.0, Phase::Descend);
+    log(2.1, 225.0, Phase::Turn);
+    rows
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -170,38 +203,6 @@ mod tests {
                 phase: Phase::Hover
             }]
         );
-    }
-
-    /// Rows of the IRIS model's experiments, with `cruise_drop` W per m/s taken off the level
-    /// flight's power.
-    fn iris_rows(cruise_drop: f64) -> Vec<Measurement> {
-        let iris = uavex_systems::coverage::SpeedEnergyModel::iris();
-        let mut rows = Vec::new();
-        let mut log = |speed: f64, power_w: f64, phase| {
-            let time_s = rows.len() as f64 * 0.1;
-            rows.push(Measurement {
-                time_s,
-                speed,
-                power_w,
-                phase,
-            });
-        };
-        for i in 0..=150 {
-            let v = i as f64 / 10.0;
-            log(v, iris.accelerating.power(v), Phase::Accelerate);
-        }
-        for i in 0..=150 {
-            let v = 15.0 - i as f64 / 10.0;
-            log(v, iris.decelerating.power(v), Phase::Decelerate);
-        }
-        for i in 0..=15 {
-            let v = i as f64;
-            log(v, iris.level.power(v) - cruise_drop * v, Phase::Cruise);
-        }
-        log(2.0, 249.0, Phase::Climb);
-        log(1.3, 212.0, Phase::Descend);
-        log(2.1, 225.0, Phase::Turn);
-        rows
     }
 
     /// A fit the model loader would refuse is refused when it is made, with the data file

@@ -94,35 +94,10 @@ fn extension(path: &Path) -> Option<String> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use uavex_systems::coverage::{FitDegrees, Measurement, Phase, fit_model};
+    use uavex_systems::coverage::{FitDegrees, fit_model};
 
     fn fitted() -> FittedModel {
-        let iris = SpeedEnergyModel::iris();
-        let mut rows = Vec::new();
-        let mut t = 0.0;
-        let mut log = |speed: f64, power_w: f64, phase| {
-            rows.push(Measurement {
-                time_s: t,
-                speed,
-                power_w,
-                phase,
-            });
-            t += 0.1;
-        };
-        for i in 0..=150 {
-            let v = i as f64 / 10.0;
-            log(v, iris.accelerating.power(v), Phase::Accelerate);
-        }
-        for i in 0..=150 {
-            let v = 15.0 - i as f64 / 10.0;
-            log(v, iris.decelerating.power(v), Phase::Decelerate);
-        }
-        for i in 0..=15 {
-            log(i as f64, iris.level.power(i as f64), Phase::Cruise);
-        }
-        log(2.0, 249.0, Phase::Climb);
-        log(1.3, 212.0, Phase::Descend);
-        log(2.1, 225.0, Phase::Turn);
+        let rows = super::super::measurements::iris_rows(0.0);
         fit_model("refit", &rows, FitDegrees::default()).unwrap()
     }
 

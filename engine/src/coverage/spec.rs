@@ -496,18 +496,22 @@ mod tests {
         );
     }
 
+    /// The spec `text`, resolved (its files beside it): its set-up for planning.
+    fn setup(text: &str) -> CoverageSetup {
+        toml::from_str::<CoverageSpec>(text)
+            .unwrap()
+            .resolve(Path::new("."), Path::new("s.toml"))
+            .unwrap()
+    }
+
+    /// Why the spec `text` cannot be planned.
+    fn plan_error(text: &str) -> String {
+        setup(text).plan().unwrap_err().to_string()
+    }
+
     #[test]
     fn planning_problems_name_the_field() {
-        let plan = |text: &str| {
-            toml::from_str::<CoverageSpec>(text)
-                .unwrap()
-                .resolve(Path::new("."), Path::new("s.toml"))
-                .unwrap()
-                .plan()
-                .unwrap_err()
-                .to_string()
-        };
-        let err = plan(&SPEC.replace(
+        let err = plan_error(&SPEC.replace(
             "altitude = { step_m = 0.5 }",
             "altitude = { step_m = 1e-30, min_altitude_m = 10.0, max_altitude_m = 10.0 }",
         ));
@@ -518,15 +522,6 @@ mod tests {
     /// `too_many_shots_field`), and the message keeps the spacings.
     #[test]
     fn too_many_photos_blame_their_cause() {
-        let plan = |text: &str| {
-            toml::from_str::<CoverageSpec>(text)
-                .unwrap()
-                .resolve(Path::new("."), Path::new("s.toml"))
-                .unwrap()
-                .plan()
-                .unwrap_err()
-                .to_string()
-        };
         let blamed = |err: &str, field: &str| {
             assert!(
                 err.starts_with(&format!("coverage {field}: covering the area at ")),
@@ -539,39 +534,39 @@ mod tests {
         };
         // Photos 3e-8 m apart along the stripes: the overlap along the track.
         blamed(
-            &plan(&SPEC.replace("y = 0.3", "y = 0.999999999")),
+            &plan_error(&SPEC.replace("y = 0.3", "y = 0.999999999")),
             "overlap.y",
         );
         // Stripes 4e-5 m apart.
-        blamed(&plan(&SPEC.replace("x = 0.2", "x = 0.999999")), "overlap.x");
+        blamed(
+            &plan_error(&SPEC.replace("x = 0.2", "x = 0.999999")),
+            "overlap.x",
+        );
         // A 4000 x 1 px image at 400 px/m: a footprint 10 m wide and 2.5 mm long.
         let wide = SPEC
             .replace("height_px = 3000", "height_px = 1")
             .replace("resolution_px_per_m = 100.0", "resolution_px_per_m = 400.0")
             .replace("step_m = 0.5", "step_m = 0.5, min_altitude_m = 1.0");
-        blamed(&plan(&wide), "camera.height_px");
+        blamed(&plan_error(&wide), "camera.height_px");
         // A 1 x 3000 px image at 200 px/m: 5 mm wide, 15 m long.
         let tall = SPEC
             .replace("width_px = 4000", "width_px = 1")
             .replace("resolution_px_per_m = 100.0", "resolution_px_per_m = 200.0")
             .replace("step_m = 0.5", "step_m = 0.5, min_altitude_m = 0.001");
-        blamed(&plan(&tall), "camera.width_px");
+        blamed(&plan_error(&tall), "camera.width_px");
         // Plain settings over 300 km x 150 km: the area itself.
         let huge = SPEC.replace(
             "[[0, 0], [0, 150], [300, 150], [300, 0]]",
             "[[0, 0], [0, 150000], [300000, 150000], [300000, 0]]",
         );
-        blamed(&plan(&huge), "area");
+        blamed(&plan_error(&huge), "area");
         // Feasible at h_max = 20 m with energy to spare, the search would go down to 0.1 m,
         // where the footprint is 200 times smaller on each side: it stops at the limit instead,
         // and keeps the plan at 20 m.
         let low = SPEC
             .replace("available_energy_j = 200000.0", "available_energy_j = 1e12")
             .replace("step_m = 0.5", "step_m = 19.9, min_altitude_m = 0.1");
-        let setup = toml::from_str::<CoverageSpec>(&low)
-            .unwrap()
-            .resolve(Path::new("."), Path::new("s.toml"))
-            .unwrap();
+        let setup = setup(&low);
         let outcome = setup.plan().unwrap();
         assert_eq!(outcome.plan.survey.altitude_m, outcome.required_altitude_m);
         assert!(outcome.photo_limit_at_m.is_some());

@@ -8,9 +8,12 @@ use std::path::{Path, PathBuf};
 /// the folder and writes and removes a file in it. Returns the folders it created, deepest
 /// first, for [`remove_created`] should the run be refused after all.
 pub fn check_out_dir(dir: &Path) -> Result<Vec<PathBuf>, String> {
+    // `a/../b` names `a/..` among its ancestors, which is no folder of its own (it is `a`'s
+    // parent), so only ancestors that end in a name are listed.
     let created: Vec<PathBuf> = dir
         .ancestors()
         .take_while(|d| !d.as_os_str().is_empty() && d.symlink_metadata().is_err())
+        .filter(|d| d.file_name().is_some())
         .map(PathBuf::from)
         .collect();
     let probe = dir.join(format!(".uavex-write-check-{}", std::process::id()));

@@ -220,6 +220,12 @@ fn a_refused_run_leaves_no_output_folder_it_created() {
     };
     refused("new/deeper");
     assert!(!dir.path().join("new").exists(), "both levels removed");
+    refused("up/../down");
+    assert!(
+        !dir.path().join("up").exists(),
+        "a level named on the way up removed"
+    );
+    assert!(!dir.path().join("down").exists());
     // Folders that were there before stay, with what they held; only the new level goes.
     std::fs::create_dir_all(dir.path().join("old/empty")).unwrap();
     std::fs::write(dir.path().join("old/notes.txt"), "keep").unwrap();

@@ -2,6 +2,7 @@
 
 mod console;
 mod out_dir;
+mod validate;
 
 use clap::{Parser, Subcommand};
 use console::{errln, out, outln};
@@ -10,7 +11,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Duration;
 use uavex_components::sim::Outcome;
-use uavex_engine::run::{RunOptions, RunReport, load_and_check};
+use uavex_engine::run::{RunOptions, RunReport};
 
 #[derive(Parser)]
 #[command(
@@ -44,7 +45,8 @@ enum Command {
         #[arg(long, value_name = "SECONDS", value_parser = wall_limit)]
         wall_limit: Option<Duration>,
     },
-    /// Check scenario files and report every problem with file, line, column and field.
+    /// Check scenario files and sweep plans (each scenario variant a plan makes) and report
+    /// every problem with file, line, column and field; nothing is run.
     Validate {
         #[arg(required = true)]
         scenarios: Vec<PathBuf>,
@@ -203,23 +205,7 @@ fn command(command: Command) -> ExitCode {
             overrides,
         } => calibrate_command(&airframe, out, &overrides.into_iter().collect()),
         Command::Plot { dir } => write_plots(&dir),
-        Command::Validate { scenarios } => {
-            let mut all_valid = true;
-            for path in &scenarios {
-                match load_and_check(path) {
-                    Ok(_) => outln!("{}: ok", path.display()),
-                    Err(errors) => {
-                        all_valid = false;
-                        errln!("{errors}");
-                    }
-                }
-            }
-            if all_valid {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::from(INVALID_INPUT)
-            }
-        }
+        Command::Validate { scenarios } => validate::validate_command(&scenarios),
         Command::Run {
             scenario,
             out,

@@ -239,3 +239,48 @@ fn a_refused_run_leaves_no_output_folder_it_created() {
         "keep"
     );
 }
+
+#[test]
+fn validate_checks_every_scenario_variant_of_a_plan() {
+    let dir = room_plan(3, "");
+    let (code, out, err) = uavex(dir.path(), &["validate", "plan.toml", "room.toml"]);
+    assert_eq!(code, Some(0), "{out}{err}");
+    assert_eq!(
+        out,
+        "plan.toml: ok (a sweep plan of 3 runs, 1 scenario variant checked)\nroom.toml: ok\n"
+    );
+    // One variant the scenario checks refuse, one the world builder refuses (no room for a
+    // pillar 30 m from the start), one that passes: each refused one is named with its
+    // reason, and the plan fails.
+    let dir = room_plan(
+        3,
+        "[grid]\n\"uav.0.behaviour.speed\" = [1.0, -2.0]\n\
+         \"world.obstacle.0.start_clearance\" = [0.5, 30.0]\n",
+    );
+    let (code, out, err) = uavex(dir.path(), &["validate", "plan.toml"]);
+    assert_eq!(code, Some(2), "{out}{err}");
+    assert_eq!(out, "");
+    let refused = |variant: &str| format!("plan.toml: the variant room, {variant} is refused: ");
+    assert!(
+        err.contains(&refused(
+            "uav.0.behaviour.speed = -2.0, world.obstacle.0.start_clearance = 0.5"
+        )) && err.contains("uav[0].behaviour.speed"),
+        "{err}"
+    );
+    assert!(
+        err.contains(&refused(
+            "uav.0.behaviour.speed = 1.0, world.obstacle.0.start_clearance = 30.0"
+        )) && err.contains("the world was refused")
+            && err.contains("world.obstacle[0].start_clearance"),
+        "{err}"
+    );
+    assert!(
+        !err.contains("speed = 1.0, world.obstacle.0.start_clearance = 0.5"),
+        "{err}"
+    );
+    // A plan that is itself malformed is reported as a plan.
+    let dir = room_plan(3, "[grid]\nspeed = 1.0\n");
+    let (code, _, err) = uavex(dir.path(), &["validate", "plan.toml"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("plan.toml"), "{err}");
+}

@@ -16,9 +16,10 @@ use super::apply::apply_overrides;
 use super::expand::{RunSpec, Shard, expand};
 use super::plan::Plan;
 use super::schedule::RunQueue;
+use super::validate::read_scenario;
 use crate::output::write_atomically;
 use crate::run::{RunOptions, RunReport, run as run_scenario};
-use crate::scenario::parse_str;
+use crate::scenario::{LoadedScenario, parse_str};
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -217,13 +218,8 @@ pub fn run_sweep(plan: &Plan, options: &SweepOptions) -> Result<SweepReport, Swe
     let texts: BTreeMap<&Path, Result<String, String>> = todo
         .iter()
         .map(|run| {
-            let text = std::fs::read_to_string(&run.scenario_file).map_err(|e| {
-                format!(
-                    "cannot read the scenario {}: {e}",
-                    run.scenario_file.display()
-                )
-            });
-            (run.scenario_file.as_path(), text)
+            let file = run.scenario_file.as_path();
+            (file, read_scenario(file))
         })
         .collect();
 
@@ -353,10 +349,7 @@ fn attempt_run(
     write_atomically(&dir.join(RUN_FILE), &json)
         .map_err(|e| format!("cannot write {}: {e}", dir.join(RUN_FILE).display()))?;
 
-    let text = text.as_ref().map_err(Clone::clone)?;
-    let edited = apply_overrides(text, &run.overrides).map_err(|e| e.to_string())?;
-    let loaded = parse_str(&edited, &run.scenario_file)
-        .map_err(|errors| format!("the scenario was refused:\n{errors}"))?;
+    let loaded = load_run(run, text)?;
     let options = RunOptions {
         out_dir: Some(dir.to_owned()),
         seed: Some(run.seed),
@@ -374,6 +367,18 @@ fn attempt_run(
         return Err(summary.reason);
     }
     Ok((summary.outcome == Outcome::Failed).then_some(summary.reason))
+}
+
+/// `run`'s scenario (`text`, as read from its file) with the run's overrides applied, loaded
+/// and checked; or why the run cannot start.
+pub(super) fn load_run(
+    run: &RunSpec,
+    text: &Result<String, String>,
+) -> Result<LoadedScenario, String> {
+    let text = text.as_ref().map_err(Clone::clone)?;
+    let edited = apply_overrides(text, &run.overrides).map_err(|e| e.to_string())?;
+    parse_str(&edited, &run.scenario_file)
+        .map_err(|errors| format!("the scenario was refused:\n{errors}"))
 }
 
 fn progress_bar(len: usize, show: bool) -> ProgressBar {

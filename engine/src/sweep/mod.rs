@@ -6,7 +6,8 @@
 //! - [`path`] and [`apply`]: field paths and how an override edits a scenario's text;
 //! - [`expand`](mod@expand): runs, their ids, shards;
 //! - [`execute`]: running a plan into a results folder, with [`schedule`] ordering the runs;
-//! - [`merge`](mod@merge): joining shard folders.
+//! - [`merge`](mod@merge): joining shard folders;
+//! - [`validate`]: checking a plan's scenario variants without running them.
 //!
 //! A run is a pure function of its scenario (with overrides) and seed, and nothing a run
 //! computes depends on the thread that runs it or on the other runs, so a sweep gives the same
@@ -19,6 +20,7 @@ pub mod merge;
 pub mod path;
 pub mod plan;
 pub mod schedule;
+pub mod validate;
 
 pub use apply::{Override, OverrideError, apply_overrides};
 pub use execute::{SweepError, SweepOptions, SweepReport, is_finished, run_sweep};
@@ -26,3 +28,4 @@ pub use expand::{RunCoordinates, RunSpec, Shard, expand};
 pub use merge::{MergeReport, merge};
 pub use path::OverridePath;
 pub use plan::{Plan, PlanError};
+pub use validate::{PlanCheck, RefusedVariant, check_plan, is_plan};

@@ -26,7 +26,7 @@ fn mask(c: bool) -> i64 {
 /// comparisons: an axis that slow reaches no second boundary before the segment's end (2^44),
 /// so the counts of crossings before an accepted face are the same, and `t + 15 dt` cannot
 /// overflow.
-const DT_COMPARE_CAP: i64 = 1 << 47;
+pub(super) const DT_COMPARE_CAP: i64 = 1 << 47;
 
 /// Crossings of an axis from chunk-local coordinate `local` with step `step` up to and
 /// including the one onto the face of its cube of edge `EDGE` ahead (1 to `EDGE`; any value
@@ -116,9 +116,9 @@ pub(super) fn cross_faces(
 /// it are counted: its time alone tells whether the move comes before the walk's end.
 #[derive(Debug, Clone, Copy)]
 pub(super) struct LeavingFace {
-    time: i64,
+    pub(super) time: i64,
     /// All ones for the leaving axis, zero for the others.
-    axis: [i64; 3],
+    pub(super) axis: [i64; 3],
 }
 
 /// The face reached first, at `F = min_a t_a + (ahead_a - 1) dt_a`, ties to x, then y, then z.
@@ -140,7 +140,7 @@ pub(super) fn leaving_face(ahead: [i64; 3], t: [i64; 3], dt: [i64; 3]) -> Leavin
 impl LeavingFace {
     /// The crossings of every axis up to this face, and the boundary times after them.
     #[inline(always)]
-    fn crossing(
+    pub(super) fn crossing(
         self,
         t: [i64; 3],
         dt: [i64; 3],

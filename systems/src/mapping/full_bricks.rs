@@ -1,5 +1,5 @@
 //! The full bricks around a scan as one dense bit grid, made once per scan for the growth of
-//! its free boxes (`super::free_box`).
+//! its free boxes (`super::free_box`) and the walks' runs of full bricks (`super::brick_run`).
 //!
 //! Why: a box grows a layer of bricks at a time and asks, brick by brick, whether each is full
 //! of saturated free voxels; through the chunks that is a chunk lookup and two dependent loads
@@ -68,6 +68,36 @@ impl FullBricks {
                 }
             }
         }
+    }
+
+    /// The bit of `brick` (brick coordinates), if inside the grid.
+    #[inline]
+    pub fn bit_of(&self, brick: IVec3) -> Option<i64> {
+        let r = brick - self.lo;
+        if r.cmplt(IVec3::ZERO).any() || r.cmpge(self.dims).any() {
+            return None;
+        }
+        Some(
+            i64::from(r.x)
+                + i64::from(self.dims.x)
+                    * (i64::from(r.y) + i64::from(self.dims.y) * i64::from(r.z)),
+        )
+    }
+
+    /// Bit steps for +1 brick along x, y, z.
+    #[inline]
+    pub fn strides(&self) -> [i64; 3] {
+        [
+            1,
+            i64::from(self.dims.x),
+            i64::from(self.dims.x) * i64::from(self.dims.y),
+        ]
+    }
+
+    /// Whether bit `bit` (inside the grid) is set.
+    #[inline(always)]
+    pub fn bit(&self, bit: i64) -> bool {
+        self.words[(bit as usize) / 64] >> (bit as u64 % 64) & 1 == 1
     }
 
     /// Whether `brick` (brick coordinates: key / [`BRICK_EDGE`]) is full; `false` outside the

@@ -10,10 +10,14 @@
 //! Hence a voxel that is both an end point and crossed counts as occupied, and each voxel is
 //! updated at most once per scan, with no per-scan clearing, sorting or allocation.
 //!
-//! Pass 2 crosses cubes whose voxels are all saturated free (bricks, blocks of bricks, whole
-//! chunks) in one move each ([`cross_saturated`]): a miss changes none of them, so the map is
-//! the same as if each voxel had been visited.
+//! Pass 2 skips space whose voxels are all saturated free, where a miss changes nothing, so the
+//! map is the same as if each voxel had been visited: a walk leaves the scan's free boxes
+//! around the sensor in one move each (`super::free_box`), then the run of full bricks ahead
+//! of it on the scan's brick grid (`super::brick_run`), and crosses the saturated cubes it
+//! meets after that (bricks, blocks of bricks, whole chunks) in one move each
+//! ([`cross_saturated`]).
 
+use super::brick_run::{BrickRuns, RunMove};
 use super::cube::{Cube, CubeLimit, CubeMove, WalkInChunk, cross_saturated, leave_cube};
 use super::cursor::{CURSOR_X, CURSOR_Y, CURSOR_Z, Cursor};
 use super::dda::{T_ONE, VoxelWalk, to_fixed};
@@ -64,6 +68,8 @@ pub struct ScanReport {
     pub ends_in_cubes: u64,
     /// Chunks the walks entered or crossed (one per chunk per ray).
     pub chunk_visits: u64,
+    /// Runs of full bricks crossed in one move, each past the free boxes (`brick_run`).
+    pub brick_runs: u64,
     /// Voxels in the scan's first free box (`super::free_box`; 0 when it had none).
     pub free_box_voxels: u64,
     /// Rays that ended inside a free box (skipped whole).
@@ -134,11 +140,12 @@ pub fn integrate_scan(
         // free boxes are grown after the hits (which may unsaturate a voxel) and stay valid:
         // misses only saturate more.
         let miss_rule = rule(increments.miss);
-        let free_boxes = if miss_rule.delta <= 0 {
+        let (free_boxes, gathered) = if miss_rule.delta <= 0 {
             run.free_boxes(config, origin, ends, bricks)
         } else {
-            FreeBoxes::default()
+            (FreeBoxes::default(), false)
         };
+        let bricks = &*bricks;
         let prepared = ends.iter().zip(inverses.iter()).zip(clips.iter());
         for (((&end, &inverse), &clip), &hit) in prepared.zip(rays.hit) {
             let Some(clip) = clip else {
@@ -164,6 +171,14 @@ pub fn integrate_scan(
                 run.leave_free_boxes(&free_boxes, &mut walk, clip.end_key, t_safe, visits)
             else {
                 continue;
+            };
+            let visits = if gathered {
+                let Some(visits) = run.leave_full_bricks(bricks, &mut walk, t_safe, visits) else {
+                    continue;
+                };
+                visits
+            } else {
+                visits
             };
             run.update_walk(walk, t_safe, visits, miss_rule);
         }
@@ -229,10 +244,10 @@ impl<C: ChunkAccess> Integration<'_, C> {
         origin: DVec3,
         ends: &[DVec3],
         bricks: &mut FullBricks,
-    ) -> FreeBoxes {
+    ) -> (FreeBoxes, bool) {
         let origin_key = floor_to_key(origin);
         if !config.contains_key(origin_key) {
-            return FreeBoxes::default();
+            return (FreeBoxes::default(), false);
         }
         // The keys' box from the points' box: `floor` is monotonic.
         let (lo, hi) = ends.iter().fold((origin, origin), |(lo, hi), &end| {
@@ -247,7 +262,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
             .iter()
             .next()
             .map_or(0, |b| (b.hi - b.lo + IVec3::ONE).element_product() as u64);
-        boxes
+        (boxes, true)
     }
 
     /// Moves `walk` out of each of the scan's free boxes it is in, in turn
@@ -313,6 +328,45 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let moved = IVec3::new(kx as i32 * mx, ky as i32 * my, kz as i32 * mz);
         walk.resume(key + moved, crossing.boundary_times);
         visits - passed
+    }
+
+    /// Moves `walk` (`visits` voxels to visit, its segment safe until `t_safe`) along the run
+    /// of full bricks it stands in on the scan's grid `bricks` ([`BrickRuns`]): the visits
+    /// left, or `None` when it ends in a full brick.
+    #[inline]
+    fn leave_full_bricks(
+        &mut self,
+        bricks: &FullBricks,
+        walk: &mut VoxelWalk,
+        t_safe: f64,
+        visits: u64,
+    ) -> Option<u64> {
+        if visits == 0 {
+            return Some(0);
+        }
+        let steps = walk.steps().map(i64::from);
+        let dt = walk.boundary_intervals();
+        let runs = BrickRuns::new(bricks, steps, dt, walk.last_key(), to_fixed(t_safe));
+        let key = walk.key();
+        match runs.cross(key, walk.boundary_times(), dt) {
+            RunMove::Cross(crossing) => {
+                let passed = crossing.voxels_passed() as u64;
+                debug_assert!(passed <= visits);
+                self.report.skipped_voxels += passed;
+                self.report.brick_runs += 1;
+                let [kx, ky, kz] = crossing.crossings;
+                let [mx, my, mz] = steps;
+                let moved = IVec3::new((kx * mx) as i32, (ky * my) as i32, (kz * mz) as i32);
+                walk.resume(key + moved, crossing.boundary_times);
+                Some(visits - passed)
+            }
+            RunMove::EndsInside => {
+                self.report.skipped_voxels += visits;
+                self.report.ends_in_cubes += 1;
+                None
+            }
+            RunMove::Stuck | RunMove::NotFull => Some(visits),
+        }
     }
 
     /// Updates the first `visits` voxels of `walk` (all inside the map), whose segment is safe

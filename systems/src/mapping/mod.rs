@@ -7,6 +7,8 @@
 //! - `cursor`: the walk's position inside a chunk, index and coordinates in one integer.
 //! - [`free_box`]: the box of saturated free bricks around a scan's sensor, which every ray
 //!   leaves in one move.
+//! - `brick_run`: a walk's move along the run of full bricks ahead of it, on the scan's brick
+//!   grid (`full_bricks`).
 //! - `rays`: a scan's rays checked, in voxel units, and prepared for the walks.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
@@ -19,6 +21,7 @@
 //! [`integrate_scans`] to the Map set after sensing. Chunks it creates are spawned through
 //! Commands: systems that read the map later in the same tick must run after a command flush.
 
+mod brick_run;
 pub mod cube;
 mod cursor;
 pub mod dda;

@@ -1,6 +1,6 @@
 //! The map update against a plain one (common.md §1 applied voxel by voxel to every voxel a
 //! ray crosses): whatever it skips (saturated cubes, free boxes around the sensor and beyond
-//! it), the map is the same, voxel for voxel.
+//! it, runs of full bricks), the map is the same, voxel for voxel.
 
 use super::dda::for_each_key;
 use super::tests::{Mapper, OCTOMAP, config, floor_key};
@@ -48,7 +48,7 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         miss: -847,
     };
     let (mut visits, mut skipped, mut cubes) = (0, 0, [0; 3]);
-    let (mut box_rays, mut box_exits, mut ends_in_cubes) = (0, 0, 0);
+    let (mut box_rays, mut box_exits, mut ends_in_cubes, mut runs) = (0, 0, 0, 0);
     for scan in 0..310 {
         let rays: Vec<(Vec3, bool)>;
         let origin;
@@ -73,6 +73,7 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         box_rays += report.free_box_rays;
         box_exits += report.free_box_exits;
         ends_in_cubes += report.ends_in_cubes;
+        runs += report.brick_runs;
         for (total, crossed) in cubes.iter_mut().zip(report.cubes_crossed) {
             *total += crossed;
         }
@@ -95,6 +96,8 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         box_rays > 0 && box_exits > 0,
         "free box: {box_rays} rays ended in it, {box_exits} left it"
     );
+    // And walks went on along runs of full bricks past the boxes.
+    assert!(runs > 5000, "{runs} runs of full bricks crossed");
 }
 
 /// The boxes beyond the faces of the sensor's free box (`free_box::FreeBoxes::grow`): in a
@@ -108,7 +111,7 @@ fn walks_through_the_boxes_beyond_leave_the_map_as_a_plain_update_would() {
     let mut reference = PlainMap::new(&config);
     let mut rng = ChaCha8Rng::seed_from_u64(31);
     let centre = Vec3::splat(0.05);
-    let mut beyond = 0;
+    let (mut beyond, mut runs) = (0, 0);
     for scan in 0..70 {
         let origin = centre + Vec3::from_array([0; 3].map(|_| rng.random_range(-0.04..0.04)));
         let rays = match scan {
@@ -121,13 +124,14 @@ fn walks_through_the_boxes_beyond_leave_the_map_as_a_plain_update_would() {
         let report = m.scan(origin, &rays);
         if scan > 6 {
             beyond += report.free_box_beyond;
+            runs += report.brick_runs;
         }
         reference.scan(origin, &rays, OCTOMAP);
     }
     reference.assert_equals(&m.store);
     assert!(
-        beyond > 1000,
-        "walks reached the boxes beyond {beyond} times"
+        beyond > 1000 && runs > 1000,
+        "walks reached the boxes beyond {beyond} times, crossed {runs} runs of full bricks"
     );
 }
 

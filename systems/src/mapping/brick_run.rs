@@ -162,6 +162,7 @@ fn mask(c: bool) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::mapping::cube::tests::first;
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
     use uavex_components::map::ChunkGrid;
@@ -199,17 +200,6 @@ mod tests {
         let mut bricks = FullBricks::default();
         bricks.gather(grid, lo * 4, hi * 4 + IVec3::splat(3), |flat| full[flat]);
         (bricks, move |brick| set.contains(&brick))
-    }
-
-    /// The axis whose next crossing comes first, ties to x, then y, then z (the walk's rule).
-    fn first(t: [i128; 3]) -> usize {
-        if t[0] <= t[1] && t[0] <= t[2] {
-            0
-        } else if t[1] <= t[2] {
-            1
-        } else {
-            2
-        }
     }
 
     /// The move stepping voxel by voxel (in i128, the walk's own rule) finds: on while the

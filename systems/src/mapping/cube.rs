@@ -310,7 +310,7 @@ pub(super) mod tests {
     const SEGMENT_END: i64 = 1 << 44;
 
     /// The axis whose next crossing comes first, ties to x, then y, then z (the walk's rule).
-    fn first(times: [i128; 3]) -> usize {
+    pub(in crate::mapping) fn first(times: [i128; 3]) -> usize {
         if times[0] <= times[1] && times[0] <= times[2] {
             0
         } else if times[1] <= times[2] {

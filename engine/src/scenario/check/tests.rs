@@ -412,24 +412,37 @@ fn uav_settings() {
     );
 }
 
-#[test]
-fn a_start_below_the_ground_is_refused() {
-    // Bounds that reach below the floor let a start there pass the bounds check; below the
-    // ground slab (1 m thick) no obstacle check sees it either.
+/// The scenario with bounds reaching 5 m below the floor and `from` replaced by `to`: a
+/// position there passes the bounds check, and below the ground slab (1 m thick) no obstacle
+/// check sees it either. Asserts that `path` is refused as under the ground with `value`, and
+/// that the same scenario without the ground is fine; returns the deep scenario before the
+/// replacement and the one after it.
+fn refused_below_the_ground(from: &str, to: &str, path: &str, value: &str) -> (String, String) {
     let deep = with("min = [0.0, 0.0, 0.0]", "min = [0.0, 0.0, -5.0]");
-    let below = deep.replace("[1.0, 1.0, 1.0] }", "[1.0, 1.0, -3.0] }");
+    let below = deep.replace(from, to);
     assert_eq!(
         one(&below),
         finding(
-            "uav[0].start.position",
+            path,
             "must be at or above the ground, z >= 0 (world.ground = true lays a solid floor \
              at z = 0)",
-            "[1.0, 1.0, -3.0]"
+            value
         )
     );
-    // Without the ground the same start is fine, and so is one on the floor with it.
     let no_ground = below.replace("[world.bounds]", "[world]\nground = false\n[world.bounds]");
     assert_eq!(findings(&no_ground), vec![]);
+    (deep, below)
+}
+
+#[test]
+fn a_start_below_the_ground_is_refused() {
+    let (deep, below) = refused_below_the_ground(
+        "[1.0, 1.0, 1.0] }",
+        "[1.0, 1.0, -3.0] }",
+        "uav[0].start.position",
+        "[1.0, 1.0, -3.0]",
+    );
+    // A start on the floor is fine with the ground.
     assert_eq!(
         findings(&deep.replace("[1.0, 1.0, 1.0] }", "[1.0, 1.0, 0.0] }")),
         vec![]
@@ -444,19 +457,12 @@ fn a_start_below_the_ground_is_refused() {
 
 #[test]
 fn a_waypoint_below_the_ground_is_refused() {
-    let deep = with("min = [0.0, 0.0, 0.0]", "min = [0.0, 0.0, -5.0]");
-    let below = deep.replace("[[5.0, 5.0, 1.0]]", "[[5.0, 5.0, 1.0], [5.0, 5.0, -2.0]]");
-    assert_eq!(
-        one(&below),
-        finding(
-            "uav[0].behaviour.waypoints[1]",
-            "must be at or above the ground, z >= 0 (world.ground = true lays a solid floor \
-             at z = 0)",
-            "[5.0, 5.0, -2.0]"
-        )
+    refused_below_the_ground(
+        "[[5.0, 5.0, 1.0]]",
+        "[[5.0, 5.0, 1.0], [5.0, 5.0, -2.0]]",
+        "uav[0].behaviour.waypoints[1]",
+        "[5.0, 5.0, -2.0]",
     );
-    let no_ground = below.replace("[world.bounds]", "[world]\nground = false\n[world.bounds]");
-    assert_eq!(findings(&no_ground), vec![]);
 }
 
 #[test]

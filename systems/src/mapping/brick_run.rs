@@ -162,7 +162,7 @@ fn mask(c: bool) -> i64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mapping::cube::tests::first;
+    use crate::mapping::cube::tests::{TIED_DT, first, random_axis};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
     use uavex_components::map::ChunkGrid;
@@ -273,16 +273,11 @@ mod tests {
                 for a in 0..3 {
                     match rng.random_range(0..8) {
                         0 => continue,
-                        1 => dt[a] = 1 << 40,
+                        1 => dt[a] = TIED_DT,
                         2 => dt[a] = 1 << 48,
                         _ => dt[a] = rng.random_range(1i64 << 38..1 << 43),
                     }
-                    steps[a] = if rng.random() { 1 } else { -1 };
-                    t[a] = if dt[a] == 1 << 40 {
-                        1 << 39
-                    } else {
-                        rng.random_range(0..dt[a].min(SEGMENT_END))
-                    };
+                    (steps[a], t[a]) = random_axis(&mut rng, dt[a], dt[a].min(SEGMENT_END));
                 }
                 if steps == [0; 3] {
                     continue;

@@ -309,6 +309,26 @@ pub(super) mod tests {
     /// whose face comes before it.
     const SEGMENT_END: i64 = 1 << 44;
 
+    /// The interval the random test walks give the axes that are to tie: they all start half
+    /// an interval in ([`random_axis`]), so their crossings coincide.
+    pub(in crate::mapping) const TIED_DT: i64 = 1 << 40;
+
+    /// A random step (+1 or -1) and first boundary time for an axis of a random test walk with
+    /// interval `dt`: half an interval in for [`TIED_DT`], else uniform below `first_below`.
+    pub(in crate::mapping) fn random_axis(
+        rng: &mut impl Rng,
+        dt: i64,
+        first_below: i64,
+    ) -> (i64, i64) {
+        let step = if rng.random() { 1 } else { -1 };
+        let t = if dt == TIED_DT {
+            TIED_DT / 2
+        } else {
+            rng.random_range(0..first_below)
+        };
+        (step, t)
+    }
+
     /// The axis whose next crossing comes first, ties to x, then y, then z (the walk's rule).
     pub(in crate::mapping) fn first(times: [i128; 3]) -> usize {
         if times[0] <= times[1] && times[0] <= times[2] {

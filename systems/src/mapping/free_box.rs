@@ -254,7 +254,7 @@ impl FreeBoxes {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::mapping::cube::tests::step_by_voxel_until;
+    use crate::mapping::cube::tests::{TIED_DT, random_axis, step_by_voxel_until};
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
@@ -368,15 +368,10 @@ mod tests {
                 // Some axes still, some intervals shared (ties), the rest random.
                 match rng.random_range(0..6) {
                     0 => continue,
-                    1 => dt[a] = 1 << 40,
+                    1 => dt[a] = TIED_DT,
                     _ => dt[a] = rng.random_range(1i64 << 36..1 << 46),
                 }
-                steps[a] = if rng.random() { 1 } else { -1 };
-                t[a] = if dt[a] == 1 << 40 {
-                    1 << 39
-                } else {
-                    rng.random_range(0..dt[a])
-                };
+                (steps[a], t[a]) = random_axis(&mut rng, dt[a], dt[a]);
             }
             if steps == [0; 3] {
                 continue;

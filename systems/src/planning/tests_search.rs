@@ -195,6 +195,34 @@ fn a_parents_moves_prune_the_moves_they_already_relaxed() {
     }
 }
 
+/// A lattice cell is open exactly when its 8 voxels are traversable (and the border cells
+/// never are), in rooms whose boxes leave cells of every kind: checks the packing of voxel
+/// rows into cell rows.
+#[test]
+fn lattice_cells_are_open_exactly_when_their_eight_voxels_are_traversable() {
+    let mut rng = ChaCha8Rng::seed_from_u64(17);
+    for _ in 0..3 {
+        let grid = boxes_in_a_room(&mut rng).grid(0.15);
+        let lattice = grid.lattice();
+        let (mut open, mut closed) = (0, 0);
+        for index in 0..lattice.len() {
+            let cell = lattice.cell(index);
+            let expected = lattice.index(cell).is_some()
+                && (0..8).all(|corner| {
+                    let offset = IVec3::new(corner & 1, corner >> 1 & 1, corner >> 2);
+                    grid.is_traversable(cell * lattice::CELL_VOXELS + offset)
+                });
+            assert_eq!(lattice.is_open(index), expected, "cell {cell}");
+            if expected {
+                open += 1;
+            } else {
+                closed += 1;
+            }
+        }
+        assert!(open > 1000 && closed > 1000, "{open} open, {closed} closed");
+    }
+}
+
 /// A known room of 4.8 x 4.8 x 2.4 m, free but for ten boxes of random places and sizes.
 fn boxes_in_a_room(rng: &mut ChaCha8Rng) -> TestMap {
     let mut map = TestMap::new(DVec3::ZERO, DVec3::new(4.8, 4.8, 2.4));

@@ -392,15 +392,25 @@ impl TraversableGrid {
                 self.dilated[s * plane + i] = self.dilated[(s - 1) * plane + i] | o << s | o >> s;
             }
         }
+        // A voxel row (ly, lz) is blocked by the OR of the ball's rows: the dilated rows at
+        // `ly + w lz + offset`. The 16 rows of one lz take their terms from 16 consecutive
+        // words for every offset, so they are ORed together, a plane at a time, from one slice
+        // each (row by row, the fold was a bounds-checked load per term).
+        const E: usize = EDGE as usize;
         let mut blocked = [0u16; ROWS];
-        for lz in 0..EDGE as usize {
-            for ly in 0..EDGE as usize {
-                let at = ly + w * lz;
-                let bits = self
-                    .ball
-                    .iter()
-                    .fold(0u64, |bits, &offset| bits | self.dilated[at + offset]);
-                blocked[ly + EDGE as usize * lz] = (bits >> r) as u16;
+        for (lz, out) in blocked.chunks_exact_mut(E).enumerate() {
+            let mut bits = [0u64; E];
+            for &offset in &self.ball {
+                let at = offset + w * lz;
+                let rows: &[u64; E] = self.dilated[at..at + E]
+                    .try_into()
+                    .expect("a slice of E words");
+                for (b, row) in bits.iter_mut().zip(rows) {
+                    *b |= row;
+                }
+            }
+            for (o, b) in out.iter_mut().zip(bits) {
+                *o = (b >> r) as u16;
             }
         }
         blocked
@@ -499,10 +509,12 @@ impl TraversableGrid {
     fn update_lattice(&mut self, first: IVec3, rows: Option<&ChunkRows>) {
         let first_cell = Lattice::cell_of_key(first);
         // Bit 2x of a voxel row pair's AND with itself shifted: voxels 2x and 2x + 1 free.
+        // The even bits, packed (bit 2x to bit x) in three shift-and-mask steps.
         let cell_bits = |pair: u16| {
-            (0..EDGE / 2).fold(0u32, |bits, cx| {
-                bits | u32::from(pair >> (2 * cx) & 1) << cx
-            })
+            let even = u32::from(pair) & 0x5555;
+            let two = (even | even >> 1) & 0x3333;
+            let four = (two | two >> 2) & 0x0f0f;
+            (four | four >> 4) & 0x00ff
         };
         self.lattice.set_rows(first_cell, EDGE / 2, |cy, cz| {
             rows.map_or(0, |rows| {

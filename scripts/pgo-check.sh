@@ -5,7 +5,8 @@
 # silently, with anything in cargo's metadata hash (Cargo.lock, the rustc version, features,
 # profile settings): the build then compiles as if there were no profile. This looks up the map
 # update's `integrate_scan`, the hottest function of a mission, in `uavex` and in the decision
-# benchmark, and tells whether the profile holds that name.
+# benchmark, and tells whether the profile holds that name; and whether the map update's
+# walk calls any `core::array` function out of line (see the loop's last check).
 #
 # usage: cargo build --release && cargo bench --no-run && scripts/pgo-check.sh
 # Needs llvm-profdata 19 or later, as scripts/pgo-train.sh. Exit status 1 if a build is missed.
@@ -26,6 +27,19 @@ for binary in target/release/uavex target/release/deps/decision-*; do
         echo "reached: $binary"
     else
         echo "MISSED:  $binary ($name is not in the profile: remake it with scripts/pgo-train.sh)"
+        status=1
+    fi
+    # The function the map update's walk is inlined into (the one holding most of
+    # integrate.rs's lines) must not call `core::array::try_map`: an `array::map` left out of
+    # line there spilled the walk's registers and cost the map update 13 % (mapping/axes.rs).
+    walk=$(objdump -d --no-show-raw-insn -C -l "$binary" 2>/dev/null \
+        | awk '/^[0-9a-f]+ </ { fn = $0 } /mapping\/integrate\.rs:/ { print fn }' \
+        | sort | uniq -c | sort -rn | head -1 | sed 's/^ *[0-9]* //')
+    calls=$(objdump -d --no-show-raw-insn -C "$binary" \
+        | awk -v walk="$walk" '$0 == walk { inside = 1; next } /^[0-9a-f]+ </ { inside = 0 }
+            inside && /call.*<core::array::/' | wc -l)
+    if [ "$calls" -gt 0 ]; then
+        echo "OUT OF LINE: $binary: the map update calls core::array functions $calls times ($walk)"
         status=1
     fi
 done

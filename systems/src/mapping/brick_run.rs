@@ -27,6 +27,7 @@
 //! builds without the profile): past the first brick that is not full, full bricks come one or
 //! two at a time, and the cubes cross them from the chunk the walk already holds.
 
+use super::axes::{by_axis, per_axis};
 use super::cube::{CubeCrossing, DT_COMPARE_CAP, LeavingFace};
 use super::full_bricks::FullBricks;
 use glam::IVec3;
@@ -80,8 +81,8 @@ impl<'a> BrickRuns<'a> {
         Self {
             bricks,
             steps,
-            dt: dt.map(|dt| dt.min(DT_COMPARE_CAP)),
-            bit_steps: [0, 1, 2].map(|a| strides[a] * steps[a]),
+            dt: per_axis(dt, |dt| dt.min(DT_COMPARE_CAP)),
+            bit_steps: by_axis(|a| strides[a] * steps[a]),
             end_bit: bricks.bit_of(end_key >> BRICK_SHIFT).unwrap_or(-1),
             t_safe,
         }
@@ -102,7 +103,7 @@ impl<'a> BrickRuns<'a> {
         // Per axis, the time of the next brick boundary: `ahead` voxel boundaries away, the
         // last of them (an axis that does not move keeps `i64::MAX`: its interval is 0).
         let edge = i64::from(BRICK_EDGE);
-        let mut b = [0, 1, 2].map(|a| {
+        let mut b = by_axis(|a| {
             let within = k[a] & (edge - 1);
             let ahead = if self.steps[a] > 0 {
                 edge - within
@@ -111,7 +112,7 @@ impl<'a> BrickRuns<'a> {
             };
             t[a].saturating_add((ahead - 1) * c[a])
         });
-        let brick_dt = c.map(|c| edge * c);
+        let brick_dt = per_axis(c, |c| edge * c);
         let mut face = None;
         loop {
             let [bx, by, bz] = b;

@@ -14,6 +14,7 @@
 //! `a` is at `t_a + j dt_a` exactly, so the cube's faces and the crossings before them are
 //! computed, not accumulated, and equal the voxel walk's to the last bit.
 
+use super::axes::{by_axis, per_axis};
 use uavex_components::map::block_bricks;
 
 /// All ones if `c`, else zero.
@@ -93,7 +94,7 @@ pub fn cross_cube<const EDGE: i64>(
     t: [i64; 3],
     dt: [i64; 3],
 ) -> CubeCrossing {
-    let ahead = [0, 1, 2].map(|a| ahead::<EDGE>(local[a], steps[a]));
+    let ahead = by_axis(|a| ahead::<EDGE>(local[a], steps[a]));
     cross_faces(ahead, t, dt, taken::<EDGE>)
 }
 
@@ -124,7 +125,7 @@ pub(super) struct LeavingFace {
 /// The face reached first, at `F = min_a t_a + (ahead_a - 1) dt_a`, ties to x, then y, then z.
 #[inline(always)]
 pub(super) fn leaving_face(ahead: [i64; 3], t: [i64; 3], dt: [i64; 3]) -> LeavingFace {
-    let [cx, cy, cz] = dt.map(|dt| dt.min(DT_COMPARE_CAP));
+    let [cx, cy, cz] = per_axis(dt, |dt| dt.min(DT_COMPARE_CAP));
     let fx = t[0] + (ahead[0] - 1) * cx;
     let fy = t[1] + (ahead[1] - 1) * cy;
     let fz = t[2] + (ahead[2] - 1) * cz;
@@ -148,7 +149,7 @@ impl LeavingFace {
     ) -> CubeCrossing {
         let [tx, ty, tz] = t;
         let [dtx, dty, dtz] = dt;
-        let [cx, cy, cz] = dt.map(|dt| dt.min(DT_COMPARE_CAP));
+        let [cx, cy, cz] = per_axis(dt, |dt| dt.min(DT_COMPARE_CAP));
         let [x, y, z] = self.axis;
         let face = self.time;
         // x wins ties against y and z, y against z: at `face`, those go first.
@@ -252,7 +253,7 @@ pub fn leave_cube<const EDGE: i64>(
 ) -> CubeMove {
     // The face first, the crossings only for a move taken: a quarter of the tries fail.
     // (`cross_cube` finds the face again; handing it this one made the mission 1 % slower.)
-    let ahead = [0, 1, 2].map(|a| ahead::<EDGE>(local[a], walk.steps[a]));
+    let ahead = by_axis(|a| ahead::<EDGE>(local[a], walk.steps[a]));
     if leaving_face(ahead, t, walk.dt).time < walk.t_safe {
         return CubeMove::Cross(cube, cross_cube::<EDGE>(local, walk.steps, t, walk.dt));
     }

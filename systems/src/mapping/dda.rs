@@ -15,6 +15,7 @@
 //! latency is shorter than floating point's, and every traversal here uses the same numbers,
 //! so all break exact ties (rays through edges and corners) the same way.
 
+use super::axes::by_axis;
 use glam::{DVec3, IVec3};
 use uavex_components::map::floor_to_key;
 
@@ -219,7 +220,9 @@ impl VoxelWalk {
     /// The key the walk ends in.
     #[inline]
     pub fn last_key(&self) -> IVec3 {
-        IVec3::from_array([0, 1, 2].map(|a| self.key[a] + self.step[a] * self.remaining[a] as i32))
+        IVec3::from_array(by_axis(|a| {
+            self.key[a] + self.step[a] * self.remaining[a] as i32
+        }))
     }
 
     /// Step (+1, -1 or 0) of the walk along each axis.

@@ -17,6 +17,7 @@
 //! meets after that (bricks, blocks of bricks, whole chunks) in one move each
 //! ([`cross_saturated`]).
 
+use super::axes::per_axis;
 use super::brick_run::{BrickRuns, RunMove};
 use super::cube::{Cube, CubeLimit, CubeMove, WalkInChunk, cross_saturated, leave_cube};
 use super::cursor::{CURSOR_X, CURSOR_Y, CURSOR_Z, Cursor};
@@ -310,7 +311,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let key = walk.key();
         let crossing = free.cross(
             key,
-            walk.steps().map(i64::from),
+            per_axis(walk.steps(), i64::from),
             walk.boundary_times(),
             walk.boundary_intervals(),
         );
@@ -344,7 +345,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         if visits == 0 {
             return Some(0);
         }
-        let steps = walk.steps().map(i64::from);
+        let steps = per_axis(walk.steps(), i64::from);
         let dt = walk.boundary_intervals();
         let runs = BrickRuns::new(bricks, steps, dt, walk.last_key(), to_fixed(t_safe));
         let key = walk.key();
@@ -416,7 +417,7 @@ impl<C: ChunkAccess> Integration<'_, C> {
         let [mut tx, mut ty, mut tz] = walk.boundary_times();
         let [dtx, dty, dtz] = walk.boundary_intervals();
         let t_safe = to_fixed(t_safe);
-        let [mx, my, mz] = walk.steps().map(i64::from);
+        let [mx, my, mz] = per_axis(walk.steps(), i64::from);
         let [cx, cy, cz] = [mx * CURSOR_X, my * CURSOR_Y, mz * CURSOR_Z];
         let mut key = walk.key();
         let last_key = walk.last_key();

@@ -1,6 +1,7 @@
 //! Map stage: integrates range scans into the occupancy map (common.md §1) and keeps the map
 //! statistics of common.md §5 up to date.
 //!
+//! - `axes`: per-axis arithmetic on the walk's arrays, written out lane by lane (why: there).
 //! - [`dda`]: Amanatides & Woo voxel traversal, clipped to the map.
 //! - [`update`]: the log-odds update of one voxel (stamp, add, clamp, statistics).
 //! - [`cube`]: walking past a cube (brick, block, chunk) of saturated free voxels in one move.
@@ -21,6 +22,7 @@
 //! [`integrate_scans`] to the Map set after sensing. Chunks it creates are spawned through
 //! Commands: systems that read the map later in the same tick must run after a command flush.
 
+mod axes;
 mod brick_run;
 pub mod cube;
 mod cursor;

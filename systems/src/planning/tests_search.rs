@@ -200,9 +200,7 @@ fn a_parents_moves_prune_the_moves_they_already_relaxed() {
 /// rows into cell rows.
 #[test]
 fn lattice_cells_are_open_exactly_when_their_eight_voxels_are_traversable() {
-    let mut rng = ChaCha8Rng::seed_from_u64(17);
-    for _ in 0..3 {
-        let grid = boxes_in_a_room(&mut rng).grid(0.15);
+    for grid in rooms_with_boxes(17) {
         let lattice = grid.lattice();
         let (mut open, mut closed) = (0, 0);
         for index in 0..lattice.len() {
@@ -221,6 +219,12 @@ fn lattice_cells_are_open_exactly_when_their_eight_voxels_are_traversable() {
         }
         assert!(open > 1000 && closed > 1000, "{open} open, {closed} closed");
     }
+}
+
+/// The grids (inflated by 0.15 m) of three rooms of [`boxes_in_a_room`], drawn from `seed`.
+fn rooms_with_boxes(seed: u64) -> impl Iterator<Item = TraversableGrid> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    (0..3).map(move |_| boxes_in_a_room(&mut rng).grid(0.15))
 }
 
 /// A known room of 4.8 x 4.8 x 2.4 m, free but for ten boxes of random places and sizes.

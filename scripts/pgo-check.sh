@@ -30,8 +30,9 @@ for binary in target/release/uavex target/release/deps/decision-*; do
         status=1
     fi
     # The function the map update's walk is inlined into (the one holding most of
-    # integrate.rs's lines) must not call `core::array::try_map`: an `array::map` left out of
-    # line there spilled the walk's registers and cost the map update 13 % (mapping/axes.rs).
+    # integrate.rs's lines) must not call a `core::array` function: an `array::map` left out
+    # of line there (`try_map`) spilled the walk's registers and cost the map update 13 %
+    # (mapping/axes.rs).
     walk=$(objdump -d --no-show-raw-insn -C -l "$binary" 2>/dev/null \
         | awk '/^[0-9a-f]+ </ { fn = $0 } /mapping\/integrate\.rs:/ { print fn }' \
         | sort | uniq -c | sort -rn | head -1 | sed 's/^ *[0-9]* //')

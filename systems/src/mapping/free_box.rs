@@ -25,6 +25,7 @@
 //! brick (a pillar's corner, a patch of floor not yet saturated) mostly goes on through free
 //! space, and a box there takes it on, or holds its end.
 
+use super::axes::by_axis;
 use super::cube::{CubeCrossing, cross_faces};
 use glam::IVec3;
 use uavex_components::map::BRICK_EDGE;
@@ -114,12 +115,11 @@ impl FreeBox {
     /// The caller accepts it only if the face comes before the end of its segment.
     #[inline]
     pub fn cross(&self, key: IVec3, steps: [i64; 3], t: [i64; 3], dt: [i64; 3]) -> CubeCrossing {
-        let ahead = |a: usize| match steps[a] {
+        let ahead = by_axis(|a| match steps[a] {
             1 => i64::from(self.hi[a] - key[a]) + 1,
             -1 => i64::from(key[a] - self.lo[a]) + 1,
             _ => 1,
-        };
-        let ahead = [ahead(0), ahead(1), ahead(2)];
+        });
         cross_faces(ahead, t, dt, |t, dt, before| {
             // The j >= 0 with t + j dt < before: ceil((before - t) / dt) of them. An axis that
             // does not move (dt = 0) has t = i64::MAX, past any `before`.

@@ -30,9 +30,12 @@ run() {
     shift 2
     if [ "$label" = old ]; then binary=$old; else binary=$new; fi
     rm -rf "/tmp/ab-pair-$label"
-    /usr/bin/time -f %e -o "/tmp/ab-pair-$label.time" taskset -c "$core" "$binary" "$@" \
-        "/tmp/ab-pair-$label" > /dev/null 2> "/tmp/ab-pair-$label.err"
-    echo "round $round $label $(cat "/tmp/ab-pair-$label.time") s" | tee -a /tmp/ab-pair-times
+    if ! /usr/bin/time -f %e -o "/tmp/ab-pair-$label.time" taskset -c "$core" "$binary" "$@" \
+        "/tmp/ab-pair-$label" > /dev/null 2> "/tmp/ab-pair-$label.err"; then
+        echo "round $round $label failed: see /tmp/ab-pair-$label.err" >&2
+        return
+    fi
+    echo "round $round $label $(tail -1 "/tmp/ab-pair-$label.time") s" | tee -a /tmp/ab-pair-times
 }
 
 for round in $(seq 1 "$rounds"); do
@@ -49,6 +52,7 @@ done
 for label in old new; do
     awk -v label="$label" '$3 == label { print $4 }' /tmp/ab-pair-times | sort -n \
         | awk -v label="$label" '{ t[NR] = $1 }
-            END { m = (NR % 2) ? t[(NR + 1) / 2] : (t[NR / 2] + t[NR / 2 + 1]) / 2;
+            END { if (NR == 0) { printf "%s: no run finished\n", label; exit }
+                  m = (NR % 2) ? t[(NR + 1) / 2] : (t[NR / 2] + t[NR / 2 + 1]) / 2;
                   printf "%s: min %.2f s, median %.2f s over %d runs\n", label, t[1], m, NR }'
 done

@@ -12,6 +12,16 @@
 //! same way. (Stretching only the offending segments does not work: a long segment between
 //! short ones bulges, and its peaks grow.)
 //!
+//! The start: the trajectory continues the start's position, velocity and acceleration, and
+//! holds its jerk too when it can (C3: the body rates, which follow from the jerk by
+//! differential flatness, stay continuous). From a moving start the held jerk can make the
+//! limits unreachable: the start's jerk does not scale with the durations, and stretching
+//! them lets the acceleration it drives grow (the scale search then gives up). The jerk is
+//! then left free (C2, as the published system's B-spline planner joins its start, and as
+//! eaae.md step 6 asks), and the allocation runs again. Over the decisions of five EAAE Pillars
+//! missions (decision bench, seeds 1-5) 27 % of all plans had failed that way, up to 34 % in
+//! one mission; with the fallback 3 % fail for the limits (docs/performance.md).
+//!
 //! Collisions: when a segment of the solution crosses a blocked point, the midpoint of that
 //! segment's straight chord is added as a waypoint and the problem solved again (Richter et
 //! al., §IV), as long as that midpoint is free.
@@ -104,23 +114,49 @@ pub fn plan_min_snap(
         )));
     }
     let yaws = unwrapped_yaws(start.yaw, waypoints);
-    let mut durations = initial_durations(start, waypoints, &yaws, limits)?;
+    for jerk in [StartJerk::Held, StartJerk::Free] {
+        if let Some(trajectory) = allocate(start, waypoints, &yaws, limits, jerk)? {
+            return Ok(trajectory);
+        }
+    }
+    Err(PlanError::LimitsUnreachable)
+}
+
+/// Whether a trajectory holds its start's jerk (module doc).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StartJerk {
+    /// Prescribed: the start's (C3).
+    Held,
+    /// Chosen by the minimum-snap solution (C2).
+    Free,
+}
+
+/// The time allocation of [`plan_min_snap`] with the start's jerk `jerk`: `None` when scaling
+/// the durations cannot meet the limits.
+fn allocate(
+    start: &TrajectoryPoint,
+    waypoints: &[Waypoint],
+    yaws: &[Option<f64>],
+    limits: &DynamicLimits,
+    jerk: StartJerk,
+) -> Result<Option<PiecewisePolynomial>, PlanError> {
+    let mut durations = initial_durations(start, waypoints, yaws, limits)?;
     let mut search = ScaleSearch::new();
     for _ in 0..MAX_ROUNDS {
-        let mut outputs = solve_position(start, waypoints, &durations)?;
+        let mut outputs = solve_position(start, waypoints, &durations, jerk)?;
         let worst = limits.worst_ratio(&trajectory_of(&durations, &outputs)?, 0.0);
         match search.step(worst) {
             Step::Accept => {
-                return match tighten(start, waypoints, &yaws, &durations, worst, limits) {
-                    Some(tightened) => Ok(tightened),
-                    None => with_yaw(start, &yaws, &durations, &mut outputs),
+                return match tighten(start, waypoints, yaws, &durations, worst, limits, jerk) {
+                    Some(tightened) => Ok(Some(tightened)),
+                    None => with_yaw(start, yaws, &durations, &mut outputs).map(Some),
                 };
             }
             Step::Scale(factor) => durations.iter_mut().for_each(|d| *d *= factor),
             Step::GiveUp => break,
         }
     }
-    Err(PlanError::LimitsUnreachable)
+    Ok(None)
 }
 
 /// Scales every duration by `worst` (< 1) so that the binding limit is met with equality,
@@ -132,12 +168,13 @@ fn tighten(
     durations: &[f64],
     worst: f64,
     limits: &DynamicLimits,
+    jerk: StartJerk,
 ) -> Option<PiecewisePolynomial> {
     if worst >= 1.0 / MARGIN || worst <= 0.0 {
         return None;
     }
     let scaled: Vec<f64> = durations.iter().map(|d| d * worst * MARGIN).collect();
-    let mut outputs = solve_position(start, waypoints, &scaled).ok()?;
+    let mut outputs = solve_position(start, waypoints, &scaled, jerk).ok()?;
     let within = limits.worst_ratio(&trajectory_of(&scaled, &outputs).ok()?, 1.0) <= 1.0;
     within.then(|| with_yaw(start, yaws, &scaled, &mut outputs).ok())?
 }
@@ -290,17 +327,18 @@ fn solve_with_durations(
     yaws: &[Option<f64>],
     durations: &[f64],
 ) -> Result<PiecewisePolynomial, PlanError> {
-    let mut outputs = solve_position(start, waypoints, durations)?;
+    let mut outputs = solve_position(start, waypoints, durations, StartJerk::Held)?;
     with_yaw(start, yaws, durations, &mut outputs)
 }
 
 /// The joint derivatives of x, y and z for the given durations (one factorisation serves the
 /// three), yaw left at zero: the limits and the collision checks read positions only, so the
-/// re-timing rounds need not solve the heading.
+/// re-timing rounds need not solve the heading. The start's jerk as `jerk` says.
 fn solve_position(
     start: &TrajectoryPoint,
     waypoints: &[Waypoint],
     durations: &[f64],
+    jerk: StartJerk,
 ) -> Result<[Vec<[f64; 4]>; 4], PlanError> {
     let last = waypoints.len();
     let axes: Vec<JointConstraints> = (0..3)
@@ -310,7 +348,7 @@ fn solve_position(
                 Some(start.position[axis]),
                 Some(start.velocity[axis]),
                 Some(start.acceleration[axis]),
-                Some(start.jerk[axis]),
+                (jerk == StartJerk::Held).then_some(start.jerk[axis]),
             ]);
             for (i, w) in waypoints.iter().enumerate() {
                 let at_rest = if i + 1 == last { Some(0.0) } else { None };
@@ -354,4 +392,67 @@ fn trajectory_of(
     outputs: &[Vec<[f64; 4]>; 4],
 ) -> Result<PiecewisePolynomial, PlanError> {
     PiecewisePolynomial::new(build_segments(durations, outputs)).map_err(PlanError::Internal)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use uavex_components::trajectory::Trajectory;
+
+    fn limits() -> DynamicLimits {
+        DynamicLimits {
+            max_velocity: 5.0,
+            max_acceleration: 4.0,
+            max_yaw_rate: 1.0,
+        }
+    }
+
+    /// A start as a decision meets it in flight: turning (acceleration across the velocity),
+    /// the turn tightening fast (jerk), from a Pillars mission's failed plans.
+    fn turning_start() -> TrajectoryPoint {
+        TrajectoryPoint {
+            position: DVec3::ZERO,
+            velocity: DVec3::new(1.7, 1.0, 0.0),
+            acceleration: DVec3::new(1.3, 1.9, 0.0),
+            jerk: DVec3::new(6.0, -5.5, 0.0),
+            ..Default::default()
+        }
+    }
+
+    /// Plans `waypoints` from `start`, checks it joins the start up to acceleration and keeps
+    /// the limits (dense samples), and returns its jerk at the start.
+    fn start_jerk_of_plan(start: &TrajectoryPoint, waypoints: &[Waypoint]) -> DVec3 {
+        let trajectory = plan_min_snap(start, waypoints, &limits()).unwrap();
+        let first = trajectory.sample(0.0);
+        assert!(first.position.distance(start.position) < 1e-9);
+        assert!(first.velocity.distance(start.velocity) < 1e-9);
+        assert!(first.acceleration.distance(start.acceleration) < 1e-9);
+        let samples = 20_000;
+        for i in 0..=samples {
+            let p = trajectory.sample(trajectory.duration() * i as f64 / samples as f64);
+            assert!(p.velocity.length() <= 5.0 * (1.0 + 1e-6), "{p:?}");
+            assert!(p.acceleration.length() <= 4.0 * (1.0 + 1e-6), "{p:?}");
+        }
+        first.jerk
+    }
+
+    #[test]
+    fn a_start_jerk_that_makes_the_limits_unreachable_is_left_free() {
+        let start = turning_start();
+        // Back against the motion: held, the start's jerk drives the acceleration past 4 m/s^2
+        // whatever the durations.
+        let waypoints = [Waypoint::new(DVec3::new(-3.0, 0.0, 0.0))];
+        let yaws = unwrapped_yaws(start.yaw, &waypoints);
+        let held = allocate(&start, &waypoints, &yaws, &limits(), StartJerk::Held).unwrap();
+        assert!(held.is_none());
+        let jerk = start_jerk_of_plan(&start, &waypoints);
+        assert!(jerk.distance(start.jerk) > 1.0, "{jerk}");
+    }
+
+    #[test]
+    fn a_start_jerk_that_allows_the_limits_is_held() {
+        let start = turning_start();
+        let jerk = start_jerk_of_plan(&start, &[Waypoint::new(DVec3::new(3.0, 0.0, 0.0))]);
+        assert!(jerk.distance(start.jerk) < 1e-9, "{jerk}");
+    }
 }

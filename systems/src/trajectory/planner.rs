@@ -18,7 +18,7 @@
 //! limits unreachable: the start's jerk does not scale with the durations, and stretching
 //! them lets the acceleration it drives grow (the scale search then gives up). The jerk is
 //! then left free (C2, as the published system's B-spline planner joins its start, and as
-//! eaae.md step 6 asks), and the allocation runs again. Over the decisions of five EAAE Pillars
+//! eaae.md step 6 allows), and the allocation runs again. Over the decisions of five EAAE Pillars
 //! missions (decision bench, seeds 1-5) 27 % of all plans had failed that way, up to 34 % in
 //! one mission; with the fallback 3 % fail for the limits (docs/performance.md).
 //!

@@ -6,12 +6,20 @@
 //! reference moving at most `max_speed` moves at most `spacing` between two samples, and with
 //! [`COLLISION_SAMPLE_SPACING_M`] = half a 0.1 m voxel no voxel the path crosses goes unseen.
 //!
+//! Samples in open space are skipped, none of them checked differently: a traversable sample
+//! whose lattice cell can make all 26 moves lies inside a cube of 6 x 6 x 6 traversable
+//! voxels (that cell and its 26 neighbours, all open: `super::lattice`), at least a voxel
+//! from its faces, so a reference moving at most `max_speed` stays in traversable space for
+//! its distance to them over `max_speed`; the samples before then are traversable and are
+//! not taken. The first untraversable sample is the one every sample would find.
+//!
 //! Escape rule: a trajectory whose first sample is not traversable (the reference starts next
 //! to a wall, or the map changed around it) may leave that place, as long as it stays within
 //! [`SNAP_RADIUS_M`] of its first sample until it reaches traversable space; from there on,
 //! every sample must be traversable. Without it, a UAV pushed 5 cm too close to a wall could
 //! never plan again.
 
+use super::lattice::Lattice;
 use super::search::SNAP_RADIUS_M;
 use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
@@ -37,26 +45,55 @@ pub fn first_untraversable(
     let mut escaping = !grid.is_traversable_point(origin);
     // Samples 5 cm apart fall in the same 0.1 m voxel half the time: its answer is kept.
     let mut last: Option<(IVec3, bool)> = None;
+    // The key of a traversable point (`None` for the others).
     let mut traversable = |p: DVec3| {
         if !p.is_finite() {
-            return false;
+            return None;
         }
         let key = grid.key_of(p);
-        match last {
+        let answer = match last {
             Some((seen, answer)) if seen == key => answer,
             _ => last.insert((key, grid.is_traversable(key))).1,
-        }
+        };
+        answer.then_some(key)
     };
     let mut segment = 0;
+    // Samples before this time are traversable (module doc).
+    let mut clear_until = f64::NEG_INFINITY;
     for t in times {
+        if t < clear_until {
+            continue;
+        }
         let p = trajectory.position_onward(t, &mut segment);
-        if traversable(p) {
+        if let Some(key) = traversable(p) {
             escaping = false;
+            clear_until = t + open_clearance(grid, key, p) / max_speed;
         } else if !escaping || p.distance(origin) > SNAP_RADIUS_M {
             return Some((t, p));
         }
     }
     None
+}
+
+/// Moves allowed from a lattice cell whose 26 neighbours are all open.
+const ALL_MOVES: u32 = (1 << 26) - 1;
+
+/// How far from the traversable point `p` (in voxel `key`) every point is traversable as far
+/// as its lattice cell tells (module doc): the distance to the faces of the cube of that cell
+/// and its 26 neighbours when all are open, less 1 % for rounding; 0 otherwise.
+fn open_clearance(grid: &TraversableGrid, key: IVec3, p: DVec3) -> f64 {
+    let lattice = grid.lattice();
+    let cell = Lattice::cell_of_key(key);
+    match lattice.index(cell) {
+        Some(index) if lattice.allowed_moves(index) == ALL_MOVES => {
+            let resolution = grid.resolution();
+            let offset = (p - lattice.centre(cell, resolution)).abs().max_element();
+            // The cube's half edge is 3 voxels; `p` lies in the middle cell, within a voxel
+            // of its centre on every axis.
+            0.99 * (3.0 * resolution - offset)
+        }
+        _ => 0.0,
+    }
 }
 
 /// The sample times of the checks: every `COLLISION_SAMPLE_SPACING_M / max_speed` from `t0`

@@ -19,7 +19,7 @@
 //! every sample must be traversable. Without it, a UAV pushed 5 cm too close to a wall could
 //! never plan again.
 
-use super::lattice::Lattice;
+use super::lattice::{ALL_MOVES, Lattice};
 use super::search::SNAP_RADIUS_M;
 use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::COLLISION_SAMPLE_SPACING_M;
@@ -74,9 +74,6 @@ pub fn first_untraversable(
     }
     None
 }
-
-/// Moves allowed from a lattice cell whose 26 neighbours are all open.
-const ALL_MOVES: u32 = (1 << 26) - 1;
 
 /// How far from the traversable point `p` (in voxel `key`) every point is traversable as far
 /// as its lattice cell tells (module doc): the distance to the faces of the cube of that cell

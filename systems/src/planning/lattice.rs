@@ -35,6 +35,10 @@ pub const MAX_LATTICE_CELLS: u64 = 1 << 30;
 /// bucket queue (Dial's algorithm) instead of a binary heap, and make equal costs exact.
 pub const MOVE_COSTS: [u64; 3] = [1000, 1414, 1732];
 
+/// Every move (bit `k` for move `k` of [`Lattice::moves`]): the allowed moves of a cell whose
+/// 26 neighbours are all open.
+pub const ALL_MOVES: u32 = (1 << 26) - 1;
+
 /// One of the 26 moves: the cell offset, its index offset, the neighbours its box needs open
 /// (target included) as a mask over [`Lattice::open_neighbours`], and its cost.
 #[derive(Debug, Clone, Copy)]

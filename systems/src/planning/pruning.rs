@@ -8,7 +8,7 @@
 //!
 //! [`Lattice::moves`]: super::lattice::Lattice::moves
 
-use super::lattice::MOVE_COSTS;
+use super::lattice::{ALL_MOVES, MOVE_COSTS};
 
 /// The moves out of a cell reached by move `arrival`, whose allowed moves are `allowed`, that
 /// cannot lower any cost; `parent_allowed` reads the moves its parent allows (needed only next
@@ -89,10 +89,6 @@ const REACH_FROM_ARRIVAL: [u32; 26] = {
     }
     reach
 };
-
-/// Every move (bit `k` for move `k` of the lattice's list): the allowed moves of a cell whose
-/// 26 neighbours are all open.
-const ALL_MOVES: u32 = (1 << 26) - 1;
 
 /// For each arrival `d`, the moves `e` from a cell whose 26 neighbours are all open that cannot
 /// lower any cost, whatever the parent allows: those [`relaxed_by_parent`] skips (the parent's

@@ -397,15 +397,8 @@ fn trajectory_of(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::trajectory::tests::limits;
     use uavex_components::trajectory::Trajectory;
-
-    fn limits() -> DynamicLimits {
-        DynamicLimits {
-            max_velocity: 5.0,
-            max_acceleration: 4.0,
-            max_yaw_rate: 1.0,
-        }
-    }
 
     /// A start as a decision meets it in flight: turning (acceleration across the velocity),
     /// the turn tightening fast (jerk), from a Pillars mission's failed plans.

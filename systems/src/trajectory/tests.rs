@@ -5,7 +5,7 @@ use glam::DVec3;
 use proptest::prelude::*;
 use uavex_components::trajectory::{PiecewisePolynomial, Trajectory, TrajectoryPoint};
 
-fn limits() -> DynamicLimits {
+pub(super) fn limits() -> DynamicLimits {
     DynamicLimits {
         max_velocity: 5.0,
         max_acceleration: 4.0,

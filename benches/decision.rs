@@ -17,7 +17,8 @@
 //! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
 //! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
 //! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_TOP=n` lists the n slowest
-//! decisions with their parts; `DECISION_LOOPS=n` replays the planning
+//! decisions with their parts; `DECISION_EXPLAIN=k` lists every plan decision `k` tries, with
+//! its outcome and time; `DECISION_LOOPS=n` replays the planning
 //! n more times (for `perf record`); `DECISION_PAUSE_S=s` prints a line and waits `s` seconds
 //! between the mission and the replay (to switch a profiler on for the replay alone: under
 //! valgrind the mission takes an hour instrumented, a few minutes not).
@@ -50,7 +51,7 @@ use uavex_systems::flight::ecs::ReferenceTrajectory;
 use uavex_systems::flight::{FlightState, RolloutConfig};
 use uavex_systems::frontier::{cluster_frontier, divisive_two_means};
 use uavex_systems::mapping::MapReader;
-use uavex_systems::planning::{Traversability, TraversableGrid};
+use uavex_systems::planning::{Traversability, TraversableGrid, find_paths, plan_along};
 use uavex_systems::trajectory::DynamicLimits;
 
 /// Replays of each part of each decision, the fastest kept (`DECISION_REPEATS` overrides it:
@@ -181,6 +182,47 @@ fn quantiles(mut v: Vec<f64>) -> (f64, f64, f64) {
     (q(0.5), q(0.95), v.last().copied().unwrap_or(0.0))
 }
 
+/// Every plan decision `k` tries (each target's centroid, then its viewpoints, as
+/// [`plan_decision`] tries them, though here every option is tried), with its outcome and time.
+fn explain(k: usize, s: &Snapshot) {
+    let start = &s.start;
+    println!(
+        "decision {k}: start {:.2?} v {:.2?} a {:.2?} j {:.2?}",
+        start.position.to_array(),
+        start.velocity.to_array(),
+        start.acceleration.to_array(),
+        start.jerk.to_array()
+    );
+    let mut goals = Vec::new();
+    let mut options = Vec::new();
+    for (i, t) in s.clusters.iter().enumerate() {
+        goals.push(t.centroid.as_dvec3());
+        options.push((i, None, None));
+        for (j, v) in t.viewpoints.iter().enumerate() {
+            goals.push(v.position.as_dvec3());
+            options.push((i, Some(j), Some(f64::from(v.yaw))));
+        }
+    }
+    let paths = find_paths(&s.grid, start.position, &goals, usize::MAX);
+    for ((target, viewpoint, yaw), path) in options.into_iter().zip(paths) {
+        let Some(path) = path else {
+            println!("  target {target:2} {viewpoint:?}: no path");
+            continue;
+        };
+        let started = Instant::now();
+        let result = plan_along(&s.grid, start, &path, yaw, &s.limits);
+        let ms = started.elapsed().as_secs_f64() * 1e3;
+        let outcome = match result {
+            Ok(plan) => format!("ok, {:.2} s", plan.trajectory.duration()),
+            Err(e) => e.to_string(),
+        };
+        println!(
+            "  target {target:2} {viewpoint:?}: {ms:6.2} ms, {} path points: {outcome}",
+            path.len()
+        );
+    }
+}
+
 /// The number in environment variable `name`, if set and well formed.
 fn env_number<T: std::str::FromStr>(name: &str) -> Option<T> {
     std::env::var(name).ok().and_then(|s| s.parse().ok())
@@ -268,6 +310,11 @@ fn main() {
             energy.push(e_ms);
             means.push(m_ms);
             totals.push(s.clustering_ms + t_ms + e_ms);
+        }
+        if let Some(k) = env_number::<usize>("DECISION_EXPLAIN")
+            && let Some(s) = snapshots.get(k)
+        {
+            explain(k, s);
         }
         for _ in 0..loops {
             for s in &snapshots {

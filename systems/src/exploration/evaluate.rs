@@ -15,7 +15,7 @@
 use super::budget::return_energies;
 use super::propose::{ClusterTarget, MAX_EXPANSIONS, PlannedCandidate};
 use crate::flight::{FlightState, RolloutConfig, RolloutResult, rollout};
-use crate::planning::{PathSearch, SightMemo, TraversableGrid, plan_along_seen};
+use crate::planning::{BrakingMemo, PathSearch, SightMemo, TraversableGrid, plan_along_seen};
 use crate::trajectory::DynamicLimits;
 use glam::{DVec3, Vec3};
 use rayon::prelude::*;
@@ -79,7 +79,8 @@ impl<'g> TargetPaths<'g> {
 /// in turn; targets without a feasible trajectory are left out. Goals within `min_travel_m`
 /// of the start are skipped: flying there gains nothing. The plans of each parallel job share
 /// one line-of-sight memo: the paths come from one search tree and ask the same questions
-/// ([`crate::planning::sight`]).
+/// ([`crate::planning::sight`]); all share the start's braking leg, for the paths that turn
+/// back ([`crate::planning::braking`]).
 pub fn plan_targets(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -91,6 +92,7 @@ pub fn plan_targets(
 ) -> Vec<PlannedCandidate> {
     paths.reach(which);
     let paths = &*paths;
+    let braking = BrakingMemo::new();
     which
         .par_iter()
         .map_init(
@@ -110,7 +112,7 @@ pub fn plan_targets(
                     if paths.search.goals()[first + k].distance(start.position) <= min_travel_m {
                         return None;
                     }
-                    let plan = plan_along_seen(sight, start, path, yaw, limits).ok()?;
+                    let plan = plan_along_seen(sight, &braking, start, path, yaw, limits).ok()?;
                     let end = plan.trajectory.sample(plan.trajectory.duration());
                     Some(PlannedCandidate {
                         target: index,

@@ -12,9 +12,14 @@
 //! dropped point back at once was tried: solves with many waypoints cost far more than the
 //! bisection saves, up to seconds per decision.)
 //!
+//! A moving start whose path turns back first brakes to rest straight ahead, and the
+//! trajectory goes on from there ([`super::braking`]): a polynomial that must reverse the
+//! start's motion within one long segment runs on the way the UAV went.
+//!
 //! Headings face the direction of travel at every waypoint (the depth camera looks forward,
 //! where the UAV is going), and `end_yaw` at the end when given.
 
+use super::braking::{Braking, BrakingMemo};
 use super::check::first_untraversable;
 use super::search::{MIN_POINT_SEPARATION_M, find_path, path_length, shortcut_indices};
 use super::sight::SightMemo;
@@ -38,8 +43,9 @@ pub struct GlobalPlan {
 /// moving) along `path` (e.g. from [`super::find_paths`]; its leading points within 1 cm of
 /// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
 /// direction of the last leg). Waypoints are added until every sample is traversable (module
-/// doc); `Err(Collision)` when that does not converge, `Err(NoWaypoints)` when the path does
-/// not leave the start.
+/// doc); when the path turns back from the start's motion, the trajectory stops first
+/// ([`super::braking`]). `Err(Collision)` when the waypoints do not converge,
+/// `Err(NoWaypoints)` when the path does not leave the start.
 pub fn plan_along(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -50,6 +56,7 @@ pub fn plan_along(
     plan_along_by(
         grid,
         |a, b| grid.line_of_sight(a, b),
+        &BrakingMemo::new(),
         start,
         path,
         end_yaw,
@@ -58,10 +65,11 @@ pub fn plan_along(
 }
 
 /// [`plan_along`] on the grid of `sight`, asking it the lines of sight of the path's
-/// shortening: the plans of one decision share one memo, and its paths most of their
-/// questions (see [`super::sight`]).
+/// shortening, with the braking leg of `braking` (for `start`): the plans of one decision
+/// share both memos, and its paths most of their questions (see [`super::sight`]).
 pub fn plan_along_seen(
     sight: &mut SightMemo,
+    braking: &BrakingMemo,
     start: &TrajectoryPoint,
     path: &[DVec3],
     end_yaw: Option<f64>,
@@ -69,13 +77,14 @@ pub fn plan_along_seen(
 ) -> Result<GlobalPlan, PlanError> {
     let grid = sight.grid();
     let sees = |a, b| sight.line_of_sight(a, b);
-    plan_along_by(grid, sees, start, path, end_yaw, limits)
+    plan_along_by(grid, sees, braking, start, path, end_yaw, limits)
 }
 
 /// [`plan_along`] with `sees(a, b)` the line of sight of the shortening.
 fn plan_along_by(
     grid: &TraversableGrid,
-    sees: impl FnMut(DVec3, DVec3) -> bool,
+    mut sees: impl FnMut(DVec3, DVec3) -> bool,
+    braking: &BrakingMemo,
     start: &TrajectoryPoint,
     path: &[DVec3],
     end_yaw: Option<f64>,
@@ -94,9 +103,42 @@ fn plan_along_by(
     if original.len() < 2 {
         return Err(PlanError::NoWaypoints);
     }
-    let kept = beyond_stopping(&shortcut_indices(&original, sees), &original, start, limits);
+    let kept = shortcut_indices(&original, &mut sees);
+    if Braking::turns_back(start, original[kept[1]])
+        && let Some(braking) = braking.get(grid, start, limits)
+    {
+        return stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
+    }
+    let kept = beyond_stopping(&kept, &original, start, limits);
     let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
     let trajectory = fit(grid, start, &original, &kept, end_yaw, limits)?;
+    Ok(GlobalPlan {
+        path_length_m: path_length(&shortened),
+        path: shortened,
+        trajectory,
+    })
+}
+
+/// The braking leg of a start that turns back, then the trajectory from rest where it stops
+/// along `original` (the start, then the path), which now begins at the stop ([`super::braking`]).
+fn stop_then_go(
+    grid: &TraversableGrid,
+    sees: impl FnMut(DVec3, DVec3) -> bool,
+    braking: &Braking,
+    start: &TrajectoryPoint,
+    mut original: Vec<DVec3>,
+    end_yaw: Option<f64>,
+    limits: &DynamicLimits,
+) -> Result<GlobalPlan, PlanError> {
+    original.insert(0, braking.stop.position);
+    let kept = shortcut_indices(&original, sees);
+    let onward = fit(grid, &braking.stop, &original, &kept, end_yaw, limits)?;
+    let mut segments = braking.trajectory.segments().to_vec();
+    segments.extend_from_slice(onward.segments());
+    let trajectory = PiecewisePolynomial::new(segments).map_err(PlanError::Internal)?;
+    let shortened: Vec<DVec3> = std::iter::once(start.position)
+        .chain(kept.iter().map(|&i| original[i]))
+        .collect();
     Ok(GlobalPlan {
         path_length_m: path_length(&shortened),
         path: shortened,

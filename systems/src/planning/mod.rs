@@ -7,6 +7,7 @@
 //!   state kept from one search to the next), which can pause at a settled cell and go on.
 //! - [`search`]: A* ([`find_path`]), one Dijkstra to many goals ([`find_paths`], or as far as
 //!   the goals asked for so far need: [`PathSearch`]), and the line-of-sight [`shortcut`].
+//! - [`braking`]: how a moving start that must turn back stops first ([`Braking`]).
 //! - [`global`]: a feasible, collision-free minimum-snap trajectory along a path
 //!   ([`plan_along`], [`plan_global`]).
 //! - [`local`]: the receding-horizon planner that flies toward the chosen goal ([`plan_local`]).
@@ -18,6 +19,7 @@
 //! changed and only when someone needs it.
 
 mod best_first;
+pub mod braking;
 pub mod check;
 pub mod global;
 pub mod lattice;
@@ -34,6 +36,7 @@ mod tests_planner;
 #[cfg(test)]
 mod tests_search;
 
+pub use braking::{Braking, BrakingMemo};
 pub use check::{first_untraversable, refresh_along, remains_traversable};
 pub use global::{GlobalPlan, plan_along, plan_along_seen, plan_global};
 pub use local::{LocalPlan, plan_local};

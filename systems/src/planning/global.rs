@@ -43,9 +43,12 @@ pub struct GlobalPlan {
 /// moving) along `path` (e.g. from [`super::find_paths`]; its leading points within 1 cm of
 /// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
 /// direction of the last leg). Waypoints are added until every sample is traversable (module
-/// doc); when the path turns back from the start's motion, the trajectory stops first
-/// ([`super::braking`]). `Err(Collision)` when the waypoints do not converge,
-/// `Err(NoWaypoints)` when the path does not leave the start.
+/// doc). `Err(Collision)` when the waypoints do not converge, `Err(NoWaypoints)` when the path
+/// does not leave the start. When no trajectory is found and the path turns back from the
+/// start's motion, the start stops first ([`super::braking`]): the local planner, which
+/// replans its flight several times a second, keeps a smooth continuation where there is one
+/// (stopping first there made the protocol's missions longer: see the README's design
+/// decisions).
 pub fn plan_along(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -53,20 +56,19 @@ pub fn plan_along(
     end_yaw: Option<f64>,
     limits: &DynamicLimits,
 ) -> Result<GlobalPlan, PlanError> {
-    plan_along_by(
-        grid,
-        |a, b| grid.line_of_sight(a, b),
-        &BrakingMemo::new(),
-        start,
-        path,
-        end_yaw,
-        limits,
-    )
+    let sees = |a, b| grid.line_of_sight(a, b);
+    plan_along_by(grid, sees, None, start, path, end_yaw, limits).or_else(|error| {
+        let braking = BrakingMemo::new();
+        plan_along_by(grid, sees, Some(&braking), start, path, end_yaw, limits).map_err(|_| error)
+    })
 }
 
 /// [`plan_along`] on the grid of `sight`, asking it the lines of sight of the path's
-/// shortening, with the braking leg of `braking` (for `start`): the plans of one decision
-/// share both memos, and its paths most of their questions (see [`super::sight`]).
+/// shortening, for a decision's candidates: when the path turns back from the start's
+/// motion, the start stops first, on the braking leg of `braking` (for `start`) — a candidate
+/// behind the UAV is priced stopping and turning, instead of by a polynomial that may run far
+/// on before it turns (or fail). The plans of one decision share both memos, and its paths
+/// most of their questions (see [`super::sight`]).
 pub fn plan_along_seen(
     sight: &mut SightMemo,
     braking: &BrakingMemo,
@@ -77,14 +79,15 @@ pub fn plan_along_seen(
 ) -> Result<GlobalPlan, PlanError> {
     let grid = sight.grid();
     let sees = |a, b| sight.line_of_sight(a, b);
-    plan_along_by(grid, sees, braking, start, path, end_yaw, limits)
+    plan_along_by(grid, sees, Some(braking), start, path, end_yaw, limits)
 }
 
-/// [`plan_along`] with `sees(a, b)` the line of sight of the shortening.
+/// [`plan_along`] with `sees(a, b)` the line of sight of the shortening; with `stop_first`, a
+/// start whose path turns back stops first.
 fn plan_along_by(
     grid: &TraversableGrid,
     mut sees: impl FnMut(DVec3, DVec3) -> bool,
-    braking: &BrakingMemo,
+    stop_first: Option<&BrakingMemo>,
     start: &TrajectoryPoint,
     path: &[DVec3],
     end_yaw: Option<f64>,
@@ -104,8 +107,9 @@ fn plan_along_by(
         return Err(PlanError::NoWaypoints);
     }
     let kept = shortcut_indices(&original, &mut sees);
-    if Braking::turns_back(start, original[kept[1]])
-        && let Some(braking) = braking.get(grid, start, limits)
+    if let Some(memo) = stop_first
+        && Braking::turns_back(start, original[kept[1]])
+        && let Some(braking) = memo.get(grid, start, limits)
     {
         return stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
     }

@@ -539,6 +539,51 @@ fn a_start_that_turns_back_stops_first_then_goes() {
     let join = braking.trajectory.duration();
     let at_stop = plan.trajectory.sample(join);
     assert!(at_stop.position.distance(stop) < 1e-9 && at_stop.velocity.length() < 1e-9);
+    // A decision's candidate stops first at once, on the shared braking leg: the same plan.
+    let path = find_path(&grid, start.position, goal, usize::MAX).unwrap();
+    let memo = BrakingMemo::new();
+    let candidate = plan_along_seen(
+        &mut SightMemo::new(&grid),
+        &memo,
+        &start,
+        &path,
+        None,
+        &limits,
+    );
+    assert_eq!(candidate.unwrap(), plan);
+}
+
+#[test]
+fn the_local_planner_turns_back_smoothly_where_it_can_and_a_candidate_stops_first() {
+    let mut map = open_room();
+    let grid = map.grid(0.27);
+    let limits = kingfisher();
+    // 1.5 m/s along +y in the middle of the room, the goal 1.5 m behind.
+    let start = TrajectoryPoint {
+        velocity: DVec3::new(0.0, 1.5, 0.0),
+        ..TrajectoryPoint::at_rest(DVec3::new(3.2, 2.5, 0.8), std::f64::consts::FRAC_PI_2)
+    };
+    let goal = DVec3::new(3.2, 1.0, 0.8);
+    let path = find_path(&grid, start.position, goal, usize::MAX).unwrap();
+    let stop = Braking::of(&grid, &start, &limits)
+        .expect("room to brake")
+        .stop
+        .position;
+    let smooth = plan_along(&grid, &start, &path, None, &limits).unwrap();
+    assert_safe(&grid, &smooth.trajectory, &limits);
+    assert!(!smooth.path.contains(&stop));
+    let memo = BrakingMemo::new();
+    let candidate = plan_along_seen(
+        &mut SightMemo::new(&grid),
+        &memo,
+        &start,
+        &path,
+        None,
+        &limits,
+    )
+    .unwrap();
+    assert_safe(&grid, &candidate.trajectory, &limits);
+    assert_eq!(candidate.path[1], stop);
 }
 
 #[test]

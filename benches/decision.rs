@@ -51,7 +51,9 @@ use uavex_systems::flight::ecs::ReferenceTrajectory;
 use uavex_systems::flight::{FlightState, RolloutConfig};
 use uavex_systems::frontier::{cluster_frontier, divisive_two_means};
 use uavex_systems::mapping::MapReader;
-use uavex_systems::planning::{Traversability, TraversableGrid, find_paths, plan_along};
+use uavex_systems::planning::{
+    BrakingMemo, SightMemo, Traversability, TraversableGrid, find_paths, plan_along_seen,
+};
 use uavex_systems::trajectory::DynamicLimits;
 
 /// Replays of each part of each decision, the fastest kept (`DECISION_REPEATS` overrides it:
@@ -204,13 +206,15 @@ fn explain(k: usize, s: &Snapshot) {
         }
     }
     let paths = find_paths(&s.grid, start.position, &goals, usize::MAX);
+    // As `plan_targets` plans them: one line-of-sight memo and one braking leg for all.
+    let (mut sight, braking) = (SightMemo::new(&s.grid), BrakingMemo::new());
     for ((target, viewpoint, yaw), path) in options.into_iter().zip(paths) {
         let Some(path) = path else {
             println!("  target {target:2} {viewpoint:?}: no path");
             continue;
         };
         let started = Instant::now();
-        let result = plan_along(&s.grid, start, &path, yaw, &s.limits);
+        let result = plan_along_seen(&mut sight, &braking, start, &path, yaw, &s.limits);
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let outcome = match result {
             Ok(plan) => format!("ok, {:.2} s", plan.trajectory.duration()),

@@ -43,12 +43,13 @@ pub struct GlobalPlan {
 /// moving) along `path` (e.g. from [`super::find_paths`]; its leading points within 1 cm of
 /// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
 /// direction of the last leg). Waypoints are added until every sample is traversable (module
-/// doc). `Err(Collision)` when the waypoints do not converge, `Err(NoWaypoints)` when the path
-/// does not leave the start. When no trajectory is found and the path turns back from the
-/// start's motion, the start stops first ([`super::braking`]): the local planner, which
-/// replans its flight several times a second, keeps a smooth continuation where there is one
-/// (stopping first there made the protocol's missions longer: see the README's design
-/// decisions).
+/// doc). When no such trajectory is found and the path turns back from the start's motion,
+/// the start stops first ([`super::braking`]). `Err(Collision)` when the waypoints do not
+/// converge, `Err(NoWaypoints)` when the path does not leave the start.
+///
+/// The local planner, which replans its flight several times a second, plans this way: it
+/// keeps a smooth continuation wherever there is one (stopping first whenever the path turned
+/// back made the protocol's missions longer: see the README's design decisions).
 pub fn plan_along(
     grid: &TraversableGrid,
     start: &TrajectoryPoint,
@@ -57,18 +58,16 @@ pub fn plan_along(
     limits: &DynamicLimits,
 ) -> Result<GlobalPlan, PlanError> {
     let sees = |a, b| grid.line_of_sight(a, b);
-    plan_along_by(grid, sees, None, start, path, end_yaw, limits).or_else(|error| {
-        let braking = BrakingMemo::new();
-        plan_along_by(grid, sees, Some(&braking), start, path, end_yaw, limits).map_err(|_| error)
-    })
+    let braking = BrakingMemo::new();
+    plan_along_by(grid, sees, &braking, false, start, path, end_yaw, limits)
 }
 
 /// [`plan_along`] on the grid of `sight`, asking it the lines of sight of the path's
-/// shortening, for a decision's candidates: when the path turns back from the start's
-/// motion, the start stops first, on the braking leg of `braking` (for `start`) — a candidate
-/// behind the UAV is priced stopping and turning, instead of by a polynomial that may run far
-/// on before it turns (or fail). The plans of one decision share both memos, and its paths
-/// most of their questions (see [`super::sight`]).
+/// shortening, for a decision's candidates: when the path turns back from the start's motion
+/// the start stops first, whether or not a smooth trajectory exists, so that a candidate
+/// behind the UAV is priced stopping and turning, never by a polynomial that runs far on
+/// before it turns. `braking` holds the braking leg of `start`. The plans of one decision share
+/// both memos, and its paths most of their questions (see [`super::sight`]).
 pub fn plan_along_seen(
     sight: &mut SightMemo,
     braking: &BrakingMemo,
@@ -79,15 +78,17 @@ pub fn plan_along_seen(
 ) -> Result<GlobalPlan, PlanError> {
     let grid = sight.grid();
     let sees = |a, b| sight.line_of_sight(a, b);
-    plan_along_by(grid, sees, Some(braking), start, path, end_yaw, limits)
+    plan_along_by(grid, sees, braking, true, start, path, end_yaw, limits)
 }
 
-/// [`plan_along`] with `sees(a, b)` the line of sight of the shortening; with `stop_first`, a
-/// start whose path turns back stops first.
+/// [`plan_along`] with `sees(a, b)` the line of sight of the shortening and the braking leg of
+/// `braking`; with `stop_when_turning_back`, a start whose path turns back stops first.
+#[allow(clippy::too_many_arguments)]
 fn plan_along_by(
     grid: &TraversableGrid,
     mut sees: impl FnMut(DVec3, DVec3) -> bool,
-    stop_first: Option<&BrakingMemo>,
+    braking: &BrakingMemo,
+    stop_when_turning_back: bool,
     start: &TrajectoryPoint,
     path: &[DVec3],
     end_yaw: Option<f64>,
@@ -100,31 +101,43 @@ fn plan_along_by(
         .iter()
         .take_while(|p| p.distance(start.position) < MIN_POINT_SEPARATION_M)
         .count();
-    let mut original = Vec::with_capacity(path.len() + 1);
+    let mut original = Vec::with_capacity(path.len() + 2);
     original.push(start.position);
     original.extend_from_slice(&path[skip..]);
     if original.len() < 2 {
         return Err(PlanError::NoWaypoints);
     }
     let kept = shortcut_indices(&original, &mut sees);
-    if let Some(memo) = stop_first
-        && Braking::turns_back(start, original[kept[1]])
-        && let Some(braking) = memo.get(grid, start, limits)
+    let turns_back = Braking::turns_back(start, original[kept[1]]);
+    if stop_when_turning_back
+        && turns_back
+        && let Some(braking) = braking.get(grid, start, limits)
     {
         return stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
     }
     let kept = beyond_stopping(&kept, &original, start, limits);
-    let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
-    let trajectory = fit(grid, start, &original, &kept, end_yaw, limits)?;
-    Ok(GlobalPlan {
-        path_length_m: path_length(&shortened),
-        path: shortened,
-        trajectory,
-    })
+    let error = match fit(grid, start, &original, &kept, end_yaw, limits) {
+        Ok(trajectory) => {
+            let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
+            return Ok(GlobalPlan {
+                path_length_m: path_length(&shortened),
+                path: shortened,
+                trajectory,
+            });
+        }
+        Err(error) => error,
+    };
+    // Stuck turning back: stop first after all.
+    match braking.get(grid, start, limits) {
+        Some(braking) if turns_back && !stop_when_turning_back => {
+            stop_then_go(grid, sees, braking, start, original, end_yaw, limits).map_err(|_| error)
+        }
+        _ => Err(error),
+    }
 }
 
-/// The braking leg of a start that turns back, then the trajectory from rest where it stops
-/// along `original` (the start, then the path), which now begins at the stop ([`super::braking`]).
+/// The braking leg of a moving start, then the trajectory from rest where it stops along
+/// `original` (the start, then the path), which now begins at the stop ([`super::braking`]).
 fn stop_then_go(
     grid: &TraversableGrid,
     sees: impl FnMut(DVec3, DVec3) -> bool,

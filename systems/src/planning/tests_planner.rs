@@ -517,6 +517,17 @@ fn turning_back() -> (TestMap, TrajectoryPoint, DVec3) {
     (map, start, DVec3::new(1.5, 0.6, 0.8))
 }
 
+/// A decision's candidate along `path` ([`plan_along_seen`], with fresh memos).
+fn candidate(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
+    path: &[DVec3],
+    limits: &DynamicLimits,
+) -> Result<GlobalPlan, crate::trajectory::PlanError> {
+    let (mut sight, braking) = (SightMemo::new(grid), BrakingMemo::new());
+    plan_along_seen(&mut sight, &braking, start, path, None, limits)
+}
+
 #[test]
 fn a_start_that_turns_back_stops_first_then_goes() {
     let (mut map, start, goal) = turning_back();
@@ -541,16 +552,7 @@ fn a_start_that_turns_back_stops_first_then_goes() {
     assert!(at_stop.position.distance(stop) < 1e-9 && at_stop.velocity.length() < 1e-9);
     // A decision's candidate stops first at once, on the shared braking leg: the same plan.
     let path = find_path(&grid, start.position, goal, usize::MAX).unwrap();
-    let memo = BrakingMemo::new();
-    let candidate = plan_along_seen(
-        &mut SightMemo::new(&grid),
-        &memo,
-        &start,
-        &path,
-        None,
-        &limits,
-    );
-    assert_eq!(candidate.unwrap(), plan);
+    assert_eq!(candidate(&grid, &start, &path, &limits).unwrap(), plan);
 }
 
 #[test]
@@ -572,16 +574,7 @@ fn the_local_planner_turns_back_smoothly_where_it_can_and_a_candidate_stops_firs
     let smooth = plan_along(&grid, &start, &path, None, &limits).unwrap();
     assert_safe(&grid, &smooth.trajectory, &limits);
     assert!(!smooth.path.contains(&stop));
-    let memo = BrakingMemo::new();
-    let candidate = plan_along_seen(
-        &mut SightMemo::new(&grid),
-        &memo,
-        &start,
-        &path,
-        None,
-        &limits,
-    )
-    .unwrap();
+    let candidate = candidate(&grid, &start, &path, &limits).unwrap();
     assert_safe(&grid, &candidate.trajectory, &limits);
     assert_eq!(candidate.path[1], stop);
 }

@@ -27,7 +27,7 @@ use std::sync::OnceLock;
 use uavex_components::trajectory::{PiecewisePolynomial, Trajectory, TrajectoryPoint};
 
 /// Braking distances tried, in multiples of the stopping distance `v^2 / 2 amax`.
-const STOPPING_MULTIPLES: [f64; 6] = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0];
+pub const STOPPING_MULTIPLES: [f64; 6] = [1.0, 1.5, 2.0, 3.0, 4.0, 6.0];
 /// A braking leg may run past its stop point by this fraction of its length (m/m) ...
 const OVERRUN_FRACTION: f64 = 0.1;
 /// ... plus this much (m).
@@ -56,7 +56,8 @@ impl Braking {
     ) -> Option<Self> {
         let speed = start.velocity.length();
         let stopping_m = speed * speed / (2.0 * limits.max_acceleration);
-        if !(stopping_m >= MIN_STOPPING_M) {
+        // (A non-finite velocity has no braking leg either.)
+        if !stopping_m.is_finite() || stopping_m < MIN_STOPPING_M {
             return None;
         }
         let ahead = start.velocity / speed;

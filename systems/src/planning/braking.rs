@@ -6,9 +6,9 @@
 //! at the yaw rate the allocation allows, and the limits' scale search stretches it further):
 //! over a long segment the polynomial keeps going the way the UAV went and comes back late. In
 //! an EAAE Pillars mission (seed 2) a UAV at 2.5 m/s, still accelerating away at 3.6 m/s^2,
-//! had every one of its 100 plans of a decision run 4.3 m on into a wall before turning, and the
-//! waypoints the fit added could not pull it back (60 ms of failed planning, 2 candidates
-//! instead of 24).
+//! had the plans of a decision to 21 of its 24 clusters run 4.3 m on into a wall before
+//! turning, and the waypoints the fit added could not pull them back (60 ms of failed
+//! planning, 2 candidates instead of 24).
 //!
 //! So such a start first brakes to rest straight ahead, and the trajectory goes on from rest
 //! there: a rest start scales exactly, and its fit behaves as any other. The braking leg is the
@@ -16,8 +16,8 @@
 //! distances (multiples of the stopping distance `v^2 / 2 amax`) at which it stops without
 //! running past that point: a polynomial stops smoothly, and a start still accelerating away
 //! needs several stopping distances (3.1 m in 1.8 s for the start above, against the 0.77 m
-//! of `v^2 / 2 amax`). The
-//! braking depends on the start alone, so the plans of one decision share it ([`BrakingMemo`]).
+//! of `v^2 / 2 amax`). The braking depends on the start alone, so the plans of one decision
+//! share it ([`BrakingMemo`]).
 
 use super::check::first_untraversable;
 use super::traversable::TraversableGrid;

@@ -12,9 +12,10 @@
 //! dropped point back at once was tried: solves with many waypoints cost far more than the
 //! bisection saves, up to seconds per decision.)
 //!
-//! A moving start whose path turns back first brakes to rest straight ahead, and the
-//! trajectory goes on from there ([`super::braking`]): a polynomial that must reverse the
-//! start's motion within one long segment runs on the way the UAV went.
+//! A decision's candidate whose path turns back from a moving start first brakes to rest
+//! straight ahead, and the trajectory goes on from there ([`super::braking`]): a polynomial
+//! that must reverse the start's motion within one long segment runs on the way the UAV went.
+//! The local planner does so only when it finds no other trajectory.
 //!
 //! Headings face the direction of travel at every waypoint (the depth camera looks forward,
 //! where the UAV is going), and `end_yaw` at the end when given.
@@ -128,12 +129,14 @@ fn plan_along_by(
         Err(error) => error,
     };
     // Stuck turning back: stop first after all.
-    match braking.get(grid, start, limits) {
-        Some(braking) if turns_back && !stop_when_turning_back => {
-            stop_then_go(grid, sees, braking, start, original, end_yaw, limits).map_err(|_| error)
-        }
-        _ => Err(error),
+    if turns_back
+        && !stop_when_turning_back
+        && let Some(braking) = braking.get(grid, start, limits)
+    {
+        return stop_then_go(grid, sees, braking, start, original, end_yaw, limits)
+            .map_err(|_| error);
     }
+    Err(error)
 }
 
 /// The braking leg of a moving start, then the trajectory from rest where it stops along

@@ -26,7 +26,7 @@
 //! `cargo bench --bench decision` (a plain timed program, `harness = false`).
 
 use bevy_ecs::prelude::*;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
 use std::io::Write;
@@ -43,6 +43,7 @@ use uavex_engine::exploration::log::percentile;
 use uavex_engine::scenario::load;
 use uavex_engine::sim::Sim;
 use uavex_systems::exploration::DecideStep;
+use uavex_systems::exploration::evaluate::{TargetGoal, target_goals};
 use uavex_systems::exploration::propose::{
     ClusterTarget, PlannedCandidate, cluster_targets, goal_rollout, plan_decision, planning_start,
     propose_candidates, roll_out_candidates,
@@ -195,26 +196,21 @@ fn explain(k: usize, s: &Snapshot) {
         start.acceleration.to_array(),
         start.jerk.to_array()
     );
-    let mut goals = Vec::new();
-    let mut options = Vec::new();
-    for (i, t) in s.clusters.iter().enumerate() {
-        goals.push(t.centroid.as_dvec3());
-        options.push((i, None, None));
-        for (j, v) in t.viewpoints.iter().enumerate() {
-            goals.push(v.position.as_dvec3());
-            options.push((i, Some(j), Some(f64::from(v.yaw))));
-        }
-    }
+    let options: Vec<(usize, TargetGoal)> = (s.clusters.iter().enumerate())
+        .flat_map(|(i, target)| target_goals(target).map(move |goal| (i, goal)))
+        .collect();
+    let goals: Vec<DVec3> = options.iter().map(|(_, goal)| goal.position).collect();
     let paths = find_paths(&s.grid, start.position, &goals, usize::MAX);
     // As `plan_targets` plans them: one line-of-sight memo and one braking leg for all.
     let (mut sight, braking) = (SightMemo::new(&s.grid), BrakingMemo::new());
-    for ((target, viewpoint, yaw), path) in options.into_iter().zip(paths) {
+    for ((target, goal), path) in options.into_iter().zip(paths) {
+        let viewpoint = goal.viewpoint;
         let Some(path) = path else {
             println!("  target {target:2} {viewpoint:?}: no path");
             continue;
         };
         let started = Instant::now();
-        let result = plan_along_seen(&mut sight, &braking, start, &path, yaw, &s.limits);
+        let result = plan_along_seen(&mut sight, &braking, start, &path, goal.yaw, &s.limits);
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let outcome = match result {
             Ok(plan) => format!("ok, {:.2} s", plan.trajectory.duration()),

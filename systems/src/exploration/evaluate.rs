@@ -24,6 +24,37 @@ use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{CandidateScope, Ranking};
 use uavex_components::trajectory::{Trajectory, TrajectoryPoint};
 
+/// One goal of a target, as a decision plans toward it: the target's centroid (no viewpoint,
+/// no heading: the heading follows the path) or one of its viewpoints.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TargetGoal {
+    pub position: DVec3,
+    /// Index of the viewpoint in the target's (`None` for the centroid).
+    pub viewpoint: Option<usize>,
+    /// The heading to arrive with (the viewpoint's).
+    pub yaw: Option<f64>,
+}
+
+/// A target's goals in the order a decision tries them (eaae.md step 6: the centroid first,
+/// then the viewpoints), the order of the goals of [`TargetPaths`].
+pub fn target_goals(target: &ClusterTarget) -> impl Iterator<Item = TargetGoal> + '_ {
+    let centroid = TargetGoal {
+        position: target.centroid.as_dvec3(),
+        viewpoint: None,
+        yaw: None,
+    };
+    let viewpoints = target
+        .viewpoints
+        .iter()
+        .enumerate()
+        .map(|(i, v)| TargetGoal {
+            position: v.position.as_dvec3(),
+            viewpoint: Some(i),
+            yaw: Some(f64::from(v.yaw)),
+        });
+    std::iter::once(centroid).chain(viewpoints)
+}
+
 /// The paths of one multi-goal search from the UAV to the targets' centroids and viewpoints,
 /// searched as far as the targets asked for so far need ([`PathSearch`]): a decision that
 /// finds its candidates among the first targets of its order stops there (the nearest-frontier
@@ -46,8 +77,7 @@ impl<'g> TargetPaths<'g> {
         let mut first_goal = Vec::with_capacity(targets.len());
         for target in targets {
             first_goal.push(goals.len());
-            goals.push(target.centroid.as_dvec3());
-            goals.extend(target.viewpoints.iter().map(|v| v.position.as_dvec3()));
+            goals.extend(target_goals(target).map(|goal| goal.position));
         }
         let search = PathSearch::new(grid, start, &goals, MAX_EXPANSIONS);
         Self {
@@ -98,28 +128,22 @@ pub fn plan_targets(
         .map_init(
             || SightMemo::new(grid),
             |sight, &index| {
-                let target = &targets[index];
                 let first = paths.first_goal[index];
-                let options = std::iter::once((None, None)).chain(
-                    target
-                        .viewpoints
-                        .iter()
-                        .enumerate()
-                        .map(|(i, v)| (Some(i), Some(f64::from(v.yaw)))),
-                );
-                options.enumerate().find_map(|(k, (viewpoint, yaw))| {
+                let mut goals = target_goals(&targets[index]).enumerate();
+                goals.find_map(|(k, goal)| {
                     let path = paths.paths[first + k].as_ref()?;
-                    if paths.search.goals()[first + k].distance(start.position) <= min_travel_m {
+                    if goal.position.distance(start.position) <= min_travel_m {
                         return None;
                     }
-                    let plan = plan_along_seen(sight, &braking, start, path, yaw, limits).ok()?;
+                    let plan =
+                        plan_along_seen(sight, &braking, start, path, goal.yaw, limits).ok()?;
                     let end = plan.trajectory.sample(plan.trajectory.duration());
                     Some(PlannedCandidate {
                         target: index,
                         goal: end.position,
                         goal_yaw: end.yaw,
                         plan,
-                        viewpoint,
+                        viewpoint: goal.viewpoint,
                     })
                 })
             },

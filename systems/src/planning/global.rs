@@ -45,8 +45,8 @@ pub struct GlobalPlan {
 /// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
 /// direction of the last leg). Waypoints are added until every sample is traversable (module
 /// doc). When no such trajectory is found and the path turns back from the start's motion,
-/// the start stops first ([`super::braking`]). `Err(Collision)` when the waypoints do not
-/// converge, `Err(NoWaypoints)` when the path does not leave the start.
+/// the start stops first ([`super::braking`]). `Err(Collision)` or `Err(StillBlocked)` when
+/// the waypoints do not converge, `Err(NoWaypoints)` when the path does not leave the start.
 ///
 /// The local planner, which replans its flight several times a second, plans this way: it
 /// keeps a smooth continuation wherever there is one (stopping first whenever the path turned
@@ -60,7 +60,10 @@ pub fn plan_along(
 ) -> Result<GlobalPlan, PlanError> {
     let sees = |a, b| grid.line_of_sight(a, b);
     let braking = BrakingMemo::new();
-    plan_along_by(grid, sees, &braking, false, start, path, end_yaw, limits)
+    let stop_first = StopFirst::WhenStuckTurningBack;
+    plan_along_by(
+        grid, sees, &braking, stop_first, start, path, end_yaw, limits,
+    )
 }
 
 /// [`plan_along`] on the grid of `sight`, asking it the lines of sight of the path's
@@ -79,17 +82,29 @@ pub fn plan_along_seen(
 ) -> Result<GlobalPlan, PlanError> {
     let grid = sight.grid();
     let sees = |a, b| sight.line_of_sight(a, b);
-    plan_along_by(grid, sees, braking, true, start, path, end_yaw, limits)
+    let stop_first = StopFirst::WhenTurningBack;
+    plan_along_by(
+        grid, sees, braking, stop_first, start, path, end_yaw, limits,
+    )
+}
+
+/// When a start whose path turns back from its motion stops first ([`super::braking`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum StopFirst {
+    /// Always (a decision's candidates: [`plan_along_seen`]).
+    WhenTurningBack,
+    /// Only when no trajectory goes on smoothly (the local planner: [`plan_along`]).
+    WhenStuckTurningBack,
 }
 
 /// [`plan_along`] with `sees(a, b)` the line of sight of the shortening and the braking leg of
-/// `braking`; with `stop_when_turning_back`, a start whose path turns back stops first.
+/// `braking`, stopping first as `stop_first` says.
 #[allow(clippy::too_many_arguments)]
 fn plan_along_by(
     grid: &TraversableGrid,
     mut sees: impl FnMut(DVec3, DVec3) -> bool,
     braking: &BrakingMemo,
-    stop_when_turning_back: bool,
+    stop_first: StopFirst,
     start: &TrajectoryPoint,
     path: &[DVec3],
     end_yaw: Option<f64>,
@@ -110,7 +125,7 @@ fn plan_along_by(
     }
     let kept = shortcut_indices(&original, &mut sees);
     let turns_back = Braking::turns_back(start, original[kept[1]]);
-    if stop_when_turning_back
+    if stop_first == StopFirst::WhenTurningBack
         && turns_back
         && let Some(braking) = braking.get(grid, start, limits)
     {
@@ -129,8 +144,8 @@ fn plan_along_by(
         Err(error) => error,
     };
     // Stuck turning back: stop first after all.
-    if turns_back
-        && !stop_when_turning_back
+    if stop_first == StopFirst::WhenStuckTurningBack
+        && turns_back
         && let Some(braking) = braking.get(grid, start, limits)
     {
         return stop_then_go(grid, sees, braking, start, original, end_yaw, limits)
@@ -220,8 +235,10 @@ fn fit(
     // Waypoints (the start excluded) and the index in `original` each came from, if any.
     let mut positions: Vec<DVec3> = kept[1..].iter().map(|&i| original[i]).collect();
     let mut origins: Vec<Option<usize>> = kept[1..].iter().map(|&i| Some(i)).collect();
+    // Fits tried, each with one more waypoint than the last.
     let attempts = 4 * original.len() + 16;
-    for _ in 0..attempts {
+    let mut added = 0;
+    loop {
         let mut yaws = follow_headings(start.position, start.yaw, &positions);
         if let (Some(yaw), Some(last)) = (end_yaw, yaws.last_mut()) {
             *last = yaw;
@@ -240,6 +257,13 @@ fn fit(
         else {
             return Ok(trajectory);
         };
+        if added + 1 == attempts {
+            return Err(PlanError::StillBlocked {
+                added,
+                time_s,
+                position,
+            });
+        }
         let (segment, _) = trajectory.locate(time_s);
         let (from, from_origin) = if segment == 0 {
             (start.position, Some(0))
@@ -257,6 +281,6 @@ fn fit(
         }
         positions.insert(segment, point);
         origins.insert(segment, origin);
+        added += 1;
     }
-    Err(PlanError::LimitsUnreachable)
 }

@@ -42,6 +42,15 @@ pub enum PlanError {
     Collision { time_s: f64, position: DVec3 },
     #[error("no time allocation met the speed and acceleration limits")]
     LimitsUnreachable,
+    #[error(
+        "the trajectory still leaves free space at t = {time_s:.3} s near {position} after \
+         {added} added waypoints"
+    )]
+    StillBlocked {
+        added: usize,
+        time_s: f64,
+        position: DVec3,
+    },
     #[error("the minimum-snap system is singular")]
     Singular,
     #[error("no path through known free space leads to {goal}")]

@@ -226,13 +226,21 @@ pub fn plan_collision_free(
     // Each insertion halves a chord; a path that still collides after this many has a chord
     // through an obstacle, which midpoints cannot fix.
     let max_insertions = 8 * waypoints.len() + 16;
-    for _ in 0..=max_insertions {
+    let mut added = 0;
+    loop {
         let trajectory = plan_min_snap(start, &waypoints, limits)?;
         let Some((time_s, position)) =
             first_blocked(&trajectory, blocked, spacing, limits.max_velocity)?
         else {
             return Ok(trajectory);
         };
+        if added == max_insertions {
+            return Err(PlanError::StillBlocked {
+                added,
+                time_s,
+                position,
+            });
+        }
         let (segment, _) = trajectory.locate(time_s);
         let from = if segment == 0 {
             start.position
@@ -244,8 +252,8 @@ pub fn plan_collision_free(
             return Err(PlanError::Collision { time_s, position });
         }
         waypoints.insert(segment, Waypoint::new(midpoint));
+        added += 1;
     }
-    Err(PlanError::LimitsUnreachable)
 }
 
 fn check_inputs(start: &TrajectoryPoint, waypoints: &[Waypoint]) -> Result<(), PlanError> {
@@ -399,6 +407,32 @@ mod tests {
     use super::*;
     use crate::trajectory::tests::limits;
     use uavex_components::trajectory::Trajectory;
+
+    /// A tour that keeps leaving free space however many midpoints it gets (free space is
+    /// only the tour's own legs: a smooth trajectory cuts every corner) fails as still blocked
+    /// after the last insertion, not as a time allocation that missed the limits.
+    #[test]
+    fn a_tour_still_blocked_after_every_insertion_says_so() {
+        let corner = DVec3::new(4.0, 0.0, 0.0);
+        let end = DVec3::new(4.0, 4.0, 0.0);
+        let off_the_legs = |p: DVec3| {
+            let first = p.y.abs() > 1e-6 || p.x < -1e-6 || p.x > 4.0 + 1e-6;
+            let second = (p.x - 4.0).abs() > 1e-6 || p.y < -1e-6 || p.y > 4.0 + 1e-6;
+            first && second
+        };
+        let start = TrajectoryPoint::default();
+        let tour = [Waypoint::new(corner), Waypoint::new(end)];
+        let result = plan_collision_free(&start, &tour, &limits(), &off_the_legs, 0.05);
+        match result {
+            Err(PlanError::StillBlocked {
+                added, position, ..
+            }) => {
+                assert_eq!(added, 8 * tour.len() + 16);
+                assert!(off_the_legs(position), "{position}");
+            }
+            other => panic!("expected StillBlocked, got {other:?}"),
+        }
+    }
 
     /// A start as a decision meets it in flight: turning (acceleration across the velocity),
     /// the turn tightening fast (jerk), from a Pillars mission's failed plans.

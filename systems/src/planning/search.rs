@@ -323,11 +323,6 @@ impl<'g> PathSearch<'g> {
         }
     }
 
-    /// The goals, as given.
-    pub fn goals(&self) -> &[DVec3] {
-        &self.goals
-    }
-
     /// Cells the search has expanded so far.
     pub fn expanded_cells(&self) -> usize {
         self.search.as_ref().map_or(0, Search::expansions)

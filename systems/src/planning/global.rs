@@ -235,8 +235,9 @@ fn fit(
     // Waypoints (the start excluded) and the index in `original` each came from, if any.
     let mut positions: Vec<DVec3> = kept[1..].iter().map(|&i| original[i]).collect();
     let mut origins: Vec<Option<usize>> = kept[1..].iter().map(|&i| Some(i)).collect();
-    // Fits tried, each with one more waypoint than the last.
-    let attempts = 4 * original.len() + 16;
+    // Waypoints added at most, one per fit that left traversable space (the fits tried are
+    // one more).
+    let max_insertions = 4 * original.len() + 15;
     let mut added = 0;
     loop {
         let mut yaws = follow_headings(start.position, start.yaw, &positions);
@@ -257,7 +258,7 @@ fn fit(
         else {
             return Ok(trajectory);
         };
-        if added + 1 == attempts {
+        if added == max_insertions {
             return Err(PlanError::StillBlocked {
                 added,
                 time_s,

@@ -182,6 +182,12 @@ fn plan_error(index: usize, clearance: f64, error: PlanError) -> BuildError {
     let waypoint = |k: usize| format!("{behaviour}.waypoints[{k}]");
     let near =
         format!("within {clearance:.2} m (the airframe's radius and a margin) of an obstacle");
+    let at = |time_s: f64, position: DVec3| {
+        format!(
+            "t = {time_s:.2} s near ({:.2}, {:.2}, {:.2})",
+            position.x, position.y, position.z
+        )
+    };
     match error {
         PlanError::StartBlocked => BuildError::new(
             format!("uav[{index}].start.position"),
@@ -197,9 +203,22 @@ fn plan_error(index: usize, clearance: f64, error: PlanError) -> BuildError {
         PlanError::Collision { time_s, position } => BuildError::new(
             format!("{behaviour}.waypoints"),
             format!(
-                "the tour passes {near} at t = {time_s:.2} s near ({:.2}, {:.2}, {:.2}), and \
-                 the straight leg there is blocked too: add a waypoint that leads around it",
-                position.x, position.y, position.z
+                "the tour passes {near} at {}, and the straight leg there is blocked too: add a \
+                 waypoint that leads around it",
+                at(time_s, position)
+            ),
+        ),
+        // The legs are clear but the polynomial bulges off them, even with midpoints added.
+        PlanError::StillBlocked {
+            added,
+            time_s,
+            position,
+        } => BuildError::new(
+            format!("{behaviour}.waypoints"),
+            format!(
+                "the tour passes {near} at {}, and still does with {added} waypoints added along \
+                 its legs: add waypoints that hold it to a straighter path there",
+                at(time_s, position)
             ),
         ),
         other => BuildError::new(behaviour, format!("no tour could be planned: {other}")),
@@ -260,6 +279,33 @@ mod tests {
 
         let errors = airframe_of(&uav("hummingbird", &[]), 1).unwrap_err();
         assert_eq!(errors[0].path, "uav[1].airframe");
+    }
+
+    #[test]
+    fn a_blocked_tour_points_at_its_waypoints() {
+        let position = DVec3::new(1.0, 2.0, 3.0);
+        for error in [
+            PlanError::Collision {
+                time_s: 1.5,
+                position,
+            },
+            PlanError::StillBlocked {
+                added: 24,
+                time_s: 1.5,
+                position,
+            },
+        ] {
+            let built = plan_error(3, 0.3, error);
+            assert_eq!(built.path, "uav[3].behaviour.waypoints");
+            assert!(
+                built.message.contains("t = 1.50 s near (1.00, 2.00, 3.00)")
+                    && built.message.contains(": add "),
+                "{}",
+                built.message
+            );
+        }
+        let other = plan_error(3, 0.3, PlanError::Singular);
+        assert_eq!(other.path, "uav[3].behaviour");
     }
 
     #[test]

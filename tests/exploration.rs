@@ -7,6 +7,7 @@ mod common;
 
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
+use std::collections::BTreeSet;
 use uavex::components::exploration::{CandidateScope, Chosen, DecisionLog, GoalKind, GoalOutcome};
 use uavex::components::map::MapConfig;
 use uavex::components::sim::Outcome;
@@ -102,6 +103,8 @@ explores! {
     classic_explores_simple_seed_2: "eaae_simple.toml", Classic, 2;
     nearest_explores_simple_seed_1: "eaae_simple.toml", Nearest, 1;
     nearest_explores_simple_seed_2: "eaae_simple.toml", Nearest, 2;
+    tour_explores_pillars_seed_1: "eaae_pillars.toml", Tour, 1;
+    tour_explores_simple_seed_1: "eaae_simple.toml", Tour, 1;
 }
 
 /// The decision log of the first `seconds` of a run.
@@ -318,32 +321,47 @@ fn unified_mode_flies_what_it_predicted() {
     assert!(mean_unified < mean_local, "{mean_unified} vs {mean_local}");
 }
 
-/// The shipped protocol plan: 2 scenes x 3 strategies x 5 seeds, each run's scenario a valid
-/// exploration of the strategy its grid value names.
-#[test]
-fn the_protocol_plan_runs_every_strategy_on_both_scenes() {
+/// The runs of the shipped sweep plan `file`, each checked to be a valid exploration of the
+/// strategy (and, where the grid sets it, the candidate count) its grid values name, without
+/// map export: (scene, grid values, seed) of each.
+fn shipped_exploration_plan(file: &str) -> BTreeSet<(String, String, u64)> {
     use uavex::engine::scenario::parse_str;
     use uavex::engine::sweep::{Plan, apply_overrides, expand};
-    let path = format!(
-        "{}/scenarios/eaae_protocol.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let path = format!("{}/scenarios/{file}", env!("CARGO_MANIFEST_DIR"));
     let plan = Plan::load(std::path::Path::new(&path)).unwrap_or_else(|e| panic!("{e}"));
-    let runs = expand(&plan);
-    assert_eq!(runs.len(), 2 * 3 * 5);
-    let mut seen = std::collections::BTreeSet::new();
-    for run in &runs {
+    let mut seen = BTreeSet::new();
+    for run in &expand(&plan) {
         let text = std::fs::read_to_string(&run.scenario_file).unwrap();
         let edited = apply_overrides(&text, &run.overrides).unwrap_or_else(|e| panic!("{e}"));
         let loaded = parse_str(&edited, &run.scenario_file).unwrap_or_else(|e| panic!("{e}"));
         let BehaviourSpec::Explore(explore) = &loaded.scenario.uavs[0].behaviour else {
             panic!("{} does not explore", run.id);
         };
-        let named = run.coordinates[0].1.as_str().unwrap();
-        let strategy = serde_json::to_value(explore.strategy).unwrap();
-        assert_eq!(strategy.as_str(), Some(named));
+        for (field, value) in &run.coordinates {
+            let set = match field.as_str() {
+                "uav.0.behaviour.strategy" => serde_json::to_value(explore.strategy),
+                "uav.0.behaviour.candidates" => serde_json::to_value(explore.candidates),
+                other => panic!("{file}: unexpected grid field {other}"),
+            };
+            let named = serde_json::to_value(value).unwrap();
+            assert_eq!(set.unwrap(), named, "{}: {field}", run.id);
+        }
         assert!(!loaded.scenario.outputs.export_map);
-        seen.insert((run.scene.clone(), named.to_owned(), run.seed));
+        let values: Vec<String> = run.coordinates.iter().map(|(_, v)| v.to_string()).collect();
+        seen.insert((run.scene.clone(), values.join(", "), run.seed));
     }
-    assert_eq!(seen.len(), 30);
+    seen
+}
+
+/// The shipped protocol plan: 2 scenes x 3 strategies x 5 seeds.
+#[test]
+fn the_protocol_plan_runs_every_strategy_on_both_scenes() {
+    assert_eq!(shipped_exploration_plan("eaae_protocol.toml").len(), 30);
+}
+
+/// The shipped comparison of EAAE's choice with the tour: 2 scenes x 2 strategies x 2
+/// candidate counts x 5 seeds.
+#[test]
+fn the_tour_comparison_plan_runs_both_strategies_both_ways() {
+    assert_eq!(shipped_exploration_plan("tour_comparison.toml").len(), 40);
 }

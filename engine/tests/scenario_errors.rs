@@ -153,7 +153,7 @@ fn errors_in_an_exploration_behaviour_are_reported_at_their_field() {
         "uav[0].behaviour.strategy",
         19,
         12,
-        "unknown value 'greedy', expected one of: eaae, classic, nearest",
+        "unknown value 'greedy', expected one of: eaae, classic, nearest, tour",
     );
     assert_only(
         &explore("strategy = \"eaae\"\nevaluate = \"most\""),

@@ -19,8 +19,8 @@ use uavex_components::trajectory::Hold;
 use uavex_components::world::WorldGeometry;
 use uavex_systems::behaviour::waypoints::CLEARANCE_MARGIN_M;
 use uavex_systems::exploration::strategy::{
-    ClassicStrategy, EaaeStrategy, NearestStrategy, choose_largest_gain, choose_least_energy,
-    choose_nearest,
+    ClassicStrategy, EaaeStrategy, NearestStrategy, TourStrategy, choose_by_tour,
+    choose_largest_gain, choose_least_energy, choose_nearest,
 };
 use uavex_systems::exploration::{
     DecideStep, add_exploration_systems, insert_exploration_resources,
@@ -167,6 +167,9 @@ pub fn explorer_components(
         }),
         StrategyName::Classic => StrategyMarker::Classic,
         StrategyName::Nearest => StrategyMarker::Nearest,
+        StrategyName::Tour => StrategyMarker::Tour(TourStrategy {
+            shortlist: explore.candidates.limit(),
+        }),
     };
     Ok(((flight, explorer, NeedsDecision), marker))
 }
@@ -177,6 +180,7 @@ pub enum StrategyMarker {
     Eaae(EaaeStrategy),
     Classic,
     Nearest,
+    Tour(TourStrategy),
 }
 
 impl StrategyMarker {
@@ -195,6 +199,10 @@ impl StrategyMarker {
             StrategyMarker::Nearest => {
                 entity.insert(NearestStrategy);
                 NearestStrategy.scope()
+            }
+            StrategyMarker::Tour(s) => {
+                entity.insert(s);
+                s.scope()
             }
         };
         entity.insert(if evaluate_all {
@@ -236,6 +244,12 @@ pub fn add_exploration(
     insert_exploration_resources(world);
     add_exploration_systems(schedule);
     schedule.add_systems(
-        (choose_least_energy, choose_largest_gain, choose_nearest).in_set(DecideStep::Choose),
+        (
+            choose_least_energy,
+            choose_largest_gain,
+            choose_nearest,
+            choose_by_tour,
+        )
+            .in_set(DecideStep::Choose),
     );
 }

@@ -4,8 +4,10 @@
 //! ```toml
 //! [uav.behaviour]
 //! kind = "explore"
-//! strategy = "eaae"          # or "classic" (largest frontier), "nearest" (nearest frontier)
-//! candidates = 3             # EAAE: clusters of largest IG weighed by energy; or "all"
+//! strategy = "eaae"          # or "classic" (largest frontier), "nearest" (nearest frontier),
+//!                            # "tour" (first cluster of the least-energy tour through all)
+//! candidates = 3             # EAAE: clusters of largest IG weighed by energy (the tour's
+//!                            # stops); or "all"
 //! evaluate = "needed"        # plan and roll out only the clusters the choice needs; "all":
 //!                            # every cluster (the decision log then prices every option)
 //! unified = false            # fly the evaluated candidate itself while it stays free
@@ -26,6 +28,9 @@ pub enum StrategyName {
     Classic,
     /// Nearest centroid (eaae.md "Baselines").
     Nearest,
+    /// The first cluster of the least-energy tour through the `candidates` clusters of largest
+    /// IG (the thesis' suggested next step, eaae.md "Known weaknesses").
+    Tour,
 }
 
 /// How many clusters EAAE weighs by energy: a number, or `"all"`.
@@ -76,7 +81,8 @@ pub struct BudgetSpec {
 #[serde(deny_unknown_fields)]
 pub struct ExploreSpec {
     pub strategy: StrategyName,
-    /// EAAE's N (the thesis: 3); ignored by the baselines, which choose among all feasible.
+    /// EAAE's N (the thesis: 3), and the tour's stops; ignored by the baselines, which choose
+    /// among all feasible.
     #[serde(default = "default_candidates")]
     pub candidates: CandidateCount,
     #[serde(default)]

@@ -394,6 +394,7 @@ mod tests {
                 let target = &targets[e.candidate.target];
                 CandidateView {
                     entity: target.entity,
+                    goal: e.candidate.goal.as_vec3(),
                     information_gain: target.size,
                     centroid_distance_m: target.centroid.distance(at),
                     path_length_m: e.candidate.plan.path_length_m as f32,

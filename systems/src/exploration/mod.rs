@@ -8,7 +8,7 @@
 //!    parallel) and rolls each out through the quadrotor model (energy, duration), as
 //!    candidate entities;
 //! 3. `Choose`: exactly one strategy system per UAV marks its pick with `Chosen`
-//!    ([`strategy`]: `eaae`, `classic`, `nearest`; a new strategy is a new system here);
+//!    ([`strategy`]: `eaae`, `classic`, `nearest`, `tour`; a new strategy is a new system here);
 //! 4. `Commit`: [`commit::commit_decisions`] makes the pick the UAV's goal, logs the decision
 //!    and despawns the candidates; with nothing left to explore the UAV has finished.
 //!
@@ -19,6 +19,7 @@ pub mod budget;
 pub mod commit;
 pub mod evaluate;
 pub mod execute;
+pub mod open_tour;
 pub mod propose;
 pub mod strategy;
 

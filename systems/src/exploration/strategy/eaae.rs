@@ -32,11 +32,16 @@ pub fn least_energy_among_largest_gain(
     candidates: &[CandidateView],
     shortlist: Option<usize>,
 ) -> Option<Entity> {
+    first_min_by(&largest_gains(candidates, shortlist), |c| c.energy_j).map(|c| c.entity)
+}
+
+/// The `shortlist` candidates of largest information gain (`None`: all), largest first; equal
+/// gains keep their order.
+pub fn largest_gains(candidates: &[CandidateView], shortlist: Option<usize>) -> Vec<CandidateView> {
     let mut by_gain = candidates.to_vec();
-    // Stable: equal gains keep their order.
     by_gain.sort_by_key(|c| std::cmp::Reverse(c.information_gain));
     by_gain.truncate(shortlist.unwrap_or(usize::MAX));
-    first_min_by(&by_gain, |c| c.energy_j).map(|c| c.entity)
+    by_gain
 }
 
 /// Choose step of EAAE.

@@ -12,12 +12,15 @@
 pub mod classic;
 pub mod eaae;
 pub mod nearest;
+pub mod tour;
 
 pub use classic::{ClassicStrategy, choose_largest_gain};
 pub use eaae::{EaaeStrategy, choose_least_energy};
 pub use nearest::{NearestStrategy, choose_nearest};
+pub use tour::{TourStrategy, choose_by_tour};
 
 use bevy_ecs::prelude::*;
+use glam::Vec3;
 use uavex_components::exploration::{
     CandidateTrajectory, Candidates, NeedsDecision, PredictedDuration, PredictedEnergy,
     Unaffordable,
@@ -27,6 +30,8 @@ use uavex_components::exploration::{
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct CandidateView {
     pub entity: Entity,
+    /// Where its trajectory ends (`CandidateTrajectory::goal`).
+    pub goal: Vec3,
     pub information_gain: u32,
     pub centroid_distance_m: f32,
     pub path_length_m: f32,
@@ -59,6 +64,7 @@ pub fn choosable(candidates: &Candidates, query: &CandidateQuery) -> Vec<Candida
             let (candidate, energy, duration, unaffordable) = query.get(entity).ok()?;
             (!unaffordable).then_some(CandidateView {
                 entity,
+                goal: candidate.goal,
                 information_gain: candidate.information_gain,
                 centroid_distance_m: candidate.centroid_distance_m,
                 path_length_m: candidate.path_length_m,

@@ -2,11 +2,16 @@ use super::*;
 use crate::exploration::strategy::classic::largest_gain;
 use crate::exploration::strategy::eaae::least_energy_among_largest_gain;
 use crate::exploration::strategy::nearest::nearest;
+use crate::exploration::strategy::tour::{
+    first_of_least_energy_tour, first_of_tour_among_largest_gain,
+};
+use glam::Vec3;
 use uavex_components::exploration::{Chosen, For, NeedsDecision};
 
 fn view(index: u32, gain: u32, distance: f32, energy: f64) -> CandidateView {
     CandidateView {
         entity: Entity::from_raw_u32(index + 1).unwrap(),
+        goal: Vec3::new(distance, 0.0, 0.0),
         information_gain: gain,
         centroid_distance_m: distance,
         path_length_m: distance,
@@ -49,6 +54,41 @@ fn each_strategy_picks_by_its_own_rule() {
     assert_eq!(largest_gain(&[]), None);
 }
 
+/// Clusters on a line through the UAV, one 1.5 m behind and five ahead from 1 m on, each
+/// predicted at 100 J/m: EAAE takes the nearest ahead (100 J) and must come back past the UAV
+/// for the one behind in the end (1,150 J in all); the tour takes the one behind first (800 J).
+#[test]
+fn the_tour_takes_the_cluster_behind_first() {
+    let xs = [1.0f32, 2.0, 3.0, 4.0, 5.0, -1.5];
+    let c: Vec<CandidateView> = (xs.iter().enumerate())
+        .map(|(i, &x)| CandidateView {
+            goal: Vec3::new(x, 0.0, 0.0),
+            ..view(i as u32, 100, x.abs(), 100.0 * f64::from(x.abs()))
+        })
+        .collect();
+    assert_eq!(least_energy_among_largest_gain(&c, None), Some(c[0].entity));
+    assert_eq!(first_of_least_energy_tour(&c), Some(c[5].entity));
+    assert_eq!(
+        first_of_tour_among_largest_gain(&c, None),
+        Some(c[5].entity)
+    );
+    // The cluster behind with the least gain and a shortlist of five: it is not a stop, and
+    // the tour of the five ahead starts at the nearest.
+    let mut small_behind = c.clone();
+    small_behind[5].information_gain = 10;
+    assert_eq!(
+        first_of_tour_among_largest_gain(&small_behind, Some(5)),
+        Some(c[0].entity)
+    );
+    assert_eq!(
+        first_of_tour_among_largest_gain(&small_behind, Some(6)),
+        Some(c[5].entity)
+    );
+    // One candidate or none: no tour to weigh.
+    assert_eq!(first_of_least_energy_tour(&c[..1]), Some(c[0].entity));
+    assert_eq!(first_of_least_energy_tour(&[]), None);
+}
+
 #[test]
 fn ties_keep_the_first_candidate() {
     let c = vec![view(0, 100, 4.0, 500.0), view(1, 100, 4.0, 500.0)];
@@ -86,7 +126,7 @@ fn strategy_systems_mark_their_own_uavs() {
                         ])
                         .unwrap(),
                     ),
-                    goal: glam::Vec3::ZERO,
+                    goal: glam::Vec3::new(distance, 0.0, 0.0),
                     goal_yaw: 0.0,
                     information_gain: gain,
                     centroid_distance_m: distance,
@@ -115,11 +155,21 @@ fn strategy_systems_mark_their_own_uavs() {
     let (near, near_c) = spawn_uav(&mut world, &|u| {
         u.insert(NearestStrategy);
     });
+    let (tour, tour_c) = spawn_uav(&mut world, &|u| {
+        u.insert(TourStrategy { shortlist: None });
+    });
     let mut schedule = Schedule::default();
-    schedule.add_systems((choose_least_energy, choose_largest_gain, choose_nearest));
+    schedule.add_systems((
+        choose_least_energy,
+        choose_largest_gain,
+        choose_nearest,
+        choose_by_tour,
+    ));
     schedule.run(&mut world);
     // The 250 J / 2.5 m candidate is unaffordable: EAAE takes 700 J, Nearest 6 m.
     assert_eq!(world.get::<Chosen>(eaae), Some(&Chosen(eaae_c[2])));
+    // Tour: 700 J, then 3 m at 120 J/m (1,800 J over 15 m), against 1,100 J and 3 m back.
+    assert_eq!(world.get::<Chosen>(tour), Some(&Chosen(tour_c[2])));
     assert_eq!(world.get::<Chosen>(classic), Some(&Chosen(classic_c[0])));
     assert_eq!(world.get::<Chosen>(near), Some(&Chosen(near_c[2])));
 }

@@ -14,8 +14,10 @@
 //! at its ends change) until no reversal makes it cheaper. Both are deterministic: ties keep
 //! the stop or tour found first, in index order.
 
-/// The most stops solved exactly: 2^12 x 12 states, some 0.6 M leg additions.
-pub const EXACT_MAX: usize = 12;
+/// The most stops solved exactly: 2^9 x 9 states, some 0.13 ms (measured on 2026-12-06: 12
+/// stops took 1.6 ms, a tenth of a decision's budget, where the local search takes 0.01 ms
+/// and is within 0.13 % of the exact tour on average: `tests`).
+pub const EXACT_MAX: usize = 9;
 
 /// The costs of a tour problem of `n` stops.
 #[derive(Debug, Clone, Copy)]
@@ -283,7 +285,7 @@ mod tests {
     fn the_local_search_is_close_to_the_exact_tour() {
         let mut rng = StdRng::seed_from_u64(11);
         let (mut excess, mut equal, mut instances) = (0.0, 0, 0);
-        for n in 8..=EXACT_MAX {
+        for n in 8..=12 {
             for _ in 0..20 {
                 let (from_start, between) = plane(n, &mut rng);
                 let costs = TourCosts {

@@ -130,6 +130,29 @@ fn padded(low: f64, high: f64) -> (f64, f64) {
     (low - 0.05 * span, high + 0.05 * span)
 }
 
+/// Labels for the ticks of an axis over `low..high`: as many decimals as its ticks (about ten
+/// over the span, at 1, 2 or 5 times a power of ten) need, trailing zeros dropped, so that
+/// energies read "55000", not "55000.0", and fractions keep the digits that tell ticks apart.
+fn tick_labels(low: f64, high: f64) -> impl Fn(&f64) -> String {
+    let step = (high - low).abs() / 10.0;
+    let decimals = if step.is_finite() && step > 0.0 {
+        // One more than the step's first digit needs: ticks at 2.5 times a power of ten.
+        (1.0 - step.log10().floor()).clamp(0.0, 12.0) as usize
+    } else {
+        3
+    };
+    move |v: &f64| {
+        let text = format!("{v:.decimals$}");
+        let text = if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            &text
+        };
+        // "-0" reads as zero.
+        if text == "-0" { "0" } else { text }.to_owned()
+    }
+}
+
 /// One panel of curves: each group's mean line and its band.
 pub struct BandPanel {
     pub title: String,
@@ -177,6 +200,8 @@ impl Figure for BandFigure {
             .configure_mesh()
             .x_desc("time (s)")
             .y_desc(self.y_label.as_str())
+            .x_label_formatter(&tick_labels(0.0, t_end))
+            .y_label_formatter(&tick_labels(y0, y1))
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(draw_error)?;
@@ -291,6 +316,7 @@ impl Figure for StripFigure {
             .x_label_formatter(&name_of)
             .x_desc(self.x_label.as_str())
             .y_desc(self.y_label.as_str())
+            .y_label_formatter(&tick_labels(y0, y1))
             .label_style(("sans-serif", 12))
             .draw()
             .map_err(draw_error)?;
@@ -321,6 +347,27 @@ mod tests {
     use super::*;
 
     use crate::plot::series::Band;
+
+    #[test]
+    fn tick_labels_keep_the_digits_their_ticks_need() {
+        let energy = tick_labels(27_000.0, 50_000.0);
+        assert_eq!(
+            [energy(&30_000.0), energy(&45_000.0), energy(&27_500.0)],
+            ["30000", "45000", "27500"]
+        );
+        let fraction = tick_labels(0.9960, 0.9976);
+        assert_eq!(
+            [fraction(&0.9965), fraction(&0.997), fraction(&0.99725)],
+            ["0.9965", "0.997", "0.99725"]
+        );
+        let percent = tick_labels(0.0, 100.0);
+        assert_eq!(
+            [percent(&0.0), percent(&25.0), percent(&-0.0)],
+            ["0", "25", "0"]
+        );
+        let small = tick_labels(0.0, 1.0);
+        assert_eq!([small(&0.25), small(&0.5)], ["0.25", "0.5"]);
+    }
 
     #[test]
     fn text_is_drawn_with_the_bundled_font() {

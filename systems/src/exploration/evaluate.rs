@@ -321,8 +321,9 @@ mod tests {
     use crate::exploration::strategy::classic::largest_gain;
     use crate::exploration::strategy::eaae::least_energy_among_largest_gain;
     use crate::exploration::strategy::nearest::nearest;
+    use crate::exploration::strategy::tour::first_of_tour_among_largest_gain;
     use crate::exploration::strategy::{
-        CandidateView, ClassicStrategy, EaaeStrategy, NearestStrategy,
+        CandidateView, ClassicStrategy, EaaeStrategy, NearestStrategy, TourStrategy,
     };
     use crate::mapping::{ChunkAccess, ChunkStore};
     use bevy_ecs::entity::Entity;
@@ -430,11 +431,13 @@ mod tests {
         type Choice = fn(&[CandidateView]) -> Option<Entity>;
         let eaae3: Choice = |c| least_energy_among_largest_gain(c, Some(3));
         let eaae1: Choice = |c| least_energy_among_largest_gain(c, Some(1));
-        let cases: [(CandidateScope, Choice, usize); 4] = [
+        let tour3: Choice = |c| first_of_tour_among_largest_gain(c, Some(3));
+        let cases: [(CandidateScope, Choice, usize); 5] = [
             (ClassicStrategy.scope(), largest_gain, 1),
             (NearestStrategy.scope(), nearest, 1),
             (EaaeStrategy { shortlist: Some(3) }.scope(), eaae3, 3),
             (EaaeStrategy { shortlist: Some(1) }.scope(), eaae1, 1),
+            (TourStrategy { shortlist: Some(3) }.scope(), tour3, 3),
         ];
         for (scope, choose, needed) in cases {
             let ranked = evaluate(&inputs, &targets, at, scope);

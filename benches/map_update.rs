@@ -21,7 +21,8 @@ use uavex_components::map::{
 use uavex_components::sensor::{Scan, SensorId, SensorQuality};
 use uavex_components::sim::RunEnd;
 use uavex_systems::mapping::{
-    ChunkStore, ScanRays, insert_map_resources, integrate_scan, integrate_scans,
+    ChunkStore, ScanRays, insert_map_resources, integrate_scan, integrate_scan_tallied,
+    integrate_scans,
 };
 
 const OCTOMAP: LogOddsIncrements = LogOddsIncrements {
@@ -111,7 +112,14 @@ fn bench_plain(c: &mut Criterion) {
         let mut store = ChunkStore::new(&config);
         let mut totals = StatSums::default();
         let mut counter = ScanCounter::default();
-        let mut integrate = |store: &mut ChunkStore, totals: &mut StatSums| {
+        // With `tallied`, the report counts how the walks skipped; the timed runs do not, as
+        // the map update does not.
+        let mut integrate = |store: &mut ChunkStore, totals: &mut StatSums, tallied: bool| {
+            let integrate_scan = if tallied {
+                integrate_scan_tallied
+            } else {
+                integrate_scan
+            };
             integrate_scan(
                 &config,
                 counter.next_id(),
@@ -122,11 +130,12 @@ fn bench_plain(c: &mut Criterion) {
             )
             .expect("valid scan")
         };
-        let mut report = integrate(&mut store, &mut totals);
-        // Steady state: the frame again until its free space is saturated.
+        // Steady state: the frame again until its free space is saturated (the last time
+        // with the tallies, for the line below).
         for _ in 0..10 {
-            report = integrate(&mut store, &mut totals);
+            integrate(&mut store, &mut totals, false);
         }
+        let report = integrate(&mut store, &mut totals, true);
         let ranges = scan.endpoints.iter().map(|p| p.distance(ORIGIN));
         let (near, far) = ranges.fold((f32::MAX, 0.0_f32), |(a, b), r| (a.min(r), b.max(r)));
         println!(
@@ -139,7 +148,7 @@ fn bench_plain(c: &mut Criterion) {
             store.chunk_count()
         );
         if let Some(ns) = cpu_time_per_call(|| {
-            black_box(integrate(&mut store, &mut totals));
+            black_box(integrate(&mut store, &mut totals, false));
         }) {
             println!(
                 "{name}: CPU time {:.3} ms per frame, {:.1} M voxel visits per CPU second",
@@ -150,7 +159,7 @@ fn bench_plain(c: &mut Criterion) {
         group.sample_size(samples);
         group.throughput(Throughput::Elements(report.voxel_visits));
         group.bench_function(BenchmarkId::new("plain", name), |b| {
-            b.iter(|| black_box(integrate(&mut store, &mut totals)))
+            b.iter(|| black_box(integrate(&mut store, &mut totals, false)))
         });
     }
     group.finish();

@@ -37,7 +37,9 @@ pub mod store;
 pub mod system;
 pub mod update;
 
-pub use integrate::{ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan};
+pub use integrate::{
+    ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan, integrate_scan_tallied,
+};
 pub use read::{GroundTruth, MapReader, OccupancyMap, WorldVoxels, map_accuracy};
 pub use state_changes::{StateChange, StateChanges};
 pub use store::ChunkStore;

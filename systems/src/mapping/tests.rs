@@ -32,7 +32,7 @@ fn integrate_rays_with(
         hit: &hit,
     };
     let config = store.config().clone();
-    integrate_scan(&config, counter.next_id(), rays, inc, store, totals).unwrap()
+    integrate_scan_tallied(&config, counter.next_id(), rays, inc, store, totals).unwrap()
 }
 
 /// [`integrate_rays_with`] the OctoMap increments: a test of the consumers of the map update
@@ -81,7 +81,7 @@ pub(super) fn config() -> MapConfig {
 pub(super) struct Mapper {
     config: MapConfig,
     pub(super) store: ChunkStore,
-    totals: MapTotals,
+    pub(super) totals: MapTotals,
     counter: ScanCounter,
 }
 

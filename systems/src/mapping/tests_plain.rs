@@ -9,7 +9,7 @@ use glam::{DVec3, IVec3, Vec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use std::collections::BTreeSet;
-use uavex_components::map::{LogOddsIncrements, MapConfig, MapSettings};
+use uavex_components::map::{LogOddsIncrements, MapConfig, MapSettings, ScanCounter, StatSums};
 
 /// The update with saturated cubes crossed in one move gives the same map, voxel for voxel,
 /// as a plain reference that applies common.md §1 to every traversed voxel: hits first, then one
@@ -42,6 +42,10 @@ fn crossing_saturated_cubes_at_a_border_inside_chunks_leaves_the_map_as_a_plain_
 fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
     let mut m = Mapper::with(config.clone());
     let mut reference = PlainMap::new(&config);
+    // The same scans without the tallies, as the map update runs them.
+    let mut untallied = ChunkStore::new(&config);
+    let (mut untallied_totals, mut untallied_counter) =
+        (StatSums::default(), ScanCounter::default());
     let mut rng = ChaCha8Rng::seed_from_u64(23);
     let lidar = LogOddsIncrements {
         hit: 1386,
@@ -68,6 +72,30 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         }
         let inc = if scan % 4 == 3 { lidar } else { OCTOMAP };
         let report = m.scan_with(origin, &rays, inc);
+        let (endpoints, hit): (Vec<Vec3>, Vec<bool>) = rays.iter().copied().unzip();
+        let plain_report = integrate_scan(
+            &config,
+            untallied_counter.next_id(),
+            ScanRays {
+                origin,
+                endpoints: &endpoints,
+                hit: &hit,
+            },
+            inc,
+            &mut untallied,
+            &mut untallied_totals,
+        )
+        .unwrap();
+        assert_eq!(
+            plain_report,
+            ScanReport {
+                rays: report.rays,
+                voxel_visits: report.voxel_visits,
+                changed_voxels: report.changed_voxels,
+                ..ScanReport::default()
+            },
+            "scan {scan}: the untallied update reports the visits and changes alone"
+        );
         visits += report.voxel_visits;
         skipped += report.skipped_voxels;
         box_rays += report.free_box_rays;
@@ -80,6 +108,8 @@ fn crossing_leaves_the_map_as_a_plain_update_would(config: MapConfig) {
         reference.scan(origin, &rays, inc);
     }
     reference.assert_equals(&m.store);
+    reference.assert_equals(&untallied);
+    assert_eq!(untallied_totals, m.totals.0);
     // The skipping was exercised: a quarter of the work at least (far voxels, crossed by few
     // rays, rarely saturate here).
     assert!(

@@ -12,6 +12,7 @@
 //!   grid (`full_bricks`).
 //! - `rays`: a scan's rays checked, in voxel units, and prepared for the walks.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
+//! - [`report`]: [`ScanReport`], what an integration did (and, asked for, how it skipped).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
 //! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
 //! - [`state_changes`]: [`StateChanges`], the chunks whose voxel states changed (for consumers
@@ -32,15 +33,15 @@ mod full_bricks;
 pub mod integrate;
 mod rays;
 pub mod read;
+pub mod report;
 pub mod state_changes;
 pub mod store;
 pub mod system;
 pub mod update;
 
-pub use integrate::{
-    ChunkAccess, ScanError, ScanRays, ScanReport, integrate_scan, integrate_scan_tallied,
-};
+pub use integrate::{ChunkAccess, ScanError, ScanRays, integrate_scan, integrate_scan_tallied};
 pub use read::{GroundTruth, MapReader, OccupancyMap, WorldVoxels, map_accuracy};
+pub use report::ScanReport;
 pub use state_changes::{StateChange, StateChanges};
 pub use store::ChunkStore;
 pub use system::{MappingScratch, insert_map_resources, integrate_scans};

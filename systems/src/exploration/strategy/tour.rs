@@ -1,8 +1,9 @@
 //! Tour: the first cluster of the least-energy tour through the choosable clusters (the N of
-//! largest information gain, as EAAE shortlists them, or all). EAAE's choice is greedy (the thesis names "a tour over all clusters with energy costs (an
-//! asymmetric TSP)" as its next step, eaae.md "Known weaknesses"): it goes to the cheapest
-//! cluster now even when that leaves a cluster behind that a later decision must fly back
-//! for. This strategy orders all of them and goes to the first.
+//! largest information gain, as EAAE shortlists them, or all). EAAE's choice is greedy (the
+//! thesis names "a tour over all clusters with energy costs (an asymmetric TSP)" as its next
+//! step, eaae.md "Known weaknesses"): it goes to the cheapest cluster now even when that
+//! leaves a cluster behind that a later decision must fly back for. This strategy orders the
+//! clusters it weighs and goes to the first.
 //!
 //! Costs (our choice; the thesis gives none):
 //! - from the UAV to cluster `k`: the candidate's predicted energy `E_k` (the rollout of its

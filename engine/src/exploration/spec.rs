@@ -5,7 +5,8 @@
 //! [uav.behaviour]
 //! kind = "explore"
 //! strategy = "eaae"          # or "classic" (largest frontier), "nearest" (nearest frontier),
-//!                            # "tour" (first cluster of the least-energy tour through the candidates)
+//!                            # "tour" (first cluster of the least-energy tour through the
+//!                            # candidates)
 //! candidates = 3             # EAAE: clusters of largest IG weighed by energy (the tour's
 //!                            # stops); or "all"
 //! evaluate = "needed"        # plan and roll out only the clusters the choice needs; "all":

@@ -93,7 +93,10 @@ struct PlanFile {
 }
 
 #[derive(serde::Deserialize)]
-#[serde(deny_unknown_fields)]
+#[serde(
+    deny_unknown_fields,
+    expecting = "a [[scenario]] table: `file = \"path/to/scenario.toml\"` and an optional `name`"
+)]
 struct ScenarioEntry {
     file: PathBuf,
     name: Option<String>,
@@ -191,15 +194,7 @@ impl Plan {
             },
         )
         .map_err(|e| invalid(format!("[grid]: {e}")))?;
-        let mut paths = BTreeSet::new();
-        for axis in &grid {
-            if !paths.insert(axis.path.clone()) {
-                return Err(invalid(format!(
-                    "[grid]: `{}` is written twice (once dotted, once nested?)",
-                    axis.path
-                )));
-            }
-        }
+        one_override_per_place(&set, &grid).map_err(invalid)?;
 
         check_size(scenarios.len(), &grid, seeds.len()).map_err(invalid)?;
 
@@ -224,6 +219,44 @@ impl Plan {
             * self.grid.iter().map(|a| a.values.len()).product::<usize>()
             * self.seeds.len()
     }
+}
+
+/// Refuses overrides of one place twice: a path written twice in a table (once dotted, once
+/// nested), in both `[set]` and `[grid]`, or inside another path (`uav.0.behaviour.speed`
+/// inside `uav.0.behaviour`). Applied in turn, one would overwrite the other, and the runs'
+/// recorded coordinates would name a value some of them never flew.
+fn one_override_per_place(set: &[Override], grid: &[Axis]) -> Result<(), String> {
+    let mut paths: Vec<(&OverridePath, &str)> = set
+        .iter()
+        .map(|o| (&o.path, "[set]"))
+        .chain(grid.iter().map(|a| (&a.path, "[grid]")))
+        .collect();
+    // In lexicographic order a path comes right before the paths inside it, and every path
+    // between the two lies inside it too: comparing neighbours finds any overlap.
+    paths.sort();
+    for pair in paths.windows(2) {
+        let [(outer, outer_table), (inner, inner_table)] = pair else {
+            continue;
+        };
+        if !inner.steps().starts_with(outer.steps()) {
+            continue;
+        }
+        return Err(if outer == inner && outer_table == inner_table {
+            format!("{outer_table}: `{outer}` is written twice (once dotted, once nested?)")
+        } else if outer == inner {
+            format!(
+                "`{outer}` is in both [set] and [grid]: a run takes one value for it; \
+                 keep it in one of them"
+            )
+        } else {
+            format!(
+                "{inner_table} `{inner}` lies inside {outer_table} `{outer}`: one would \
+                 overwrite the other; override each place once (the fields of `{outer}` \
+                 one by one, or `{outer}` whole)"
+            )
+        });
+    }
+    Ok(())
 }
 
 /// Refuses a plan of more than [`MAX_RUNS`] runs, naming what multiplies up to its size (the
@@ -404,6 +437,10 @@ mod tests {
                 "is not a field path",
             ),
             ("seeds = 1\nscenarios = []", "unknown field `scenarios`"),
+            (
+                "seeds = 1\nscenario = [\"a.toml\"]",
+                "expected a [[scenario]] table: `file = \"path/to/scenario.toml\"`",
+            ),
         ];
         for (text, expected) in cases {
             let error = parse(text).expect_err(text);
@@ -467,8 +504,57 @@ mod tests {
         )
         .unwrap_err();
         assert!(
-            error.contains("`map.resolution` is written twice"),
+            error.contains("[grid]: `map.resolution` is written twice"),
             "{error}"
         );
+    }
+
+    #[test]
+    fn a_place_overridden_twice_is_refused() {
+        let plan = |set: &str, grid: &str| {
+            parse(&format!(
+                "seeds = 1\n[[scenario]]\nfile = \"a.toml\"\n[set]\n{set}\n[grid]\n{grid}"
+            ))
+        };
+        let cases = [
+            (
+                "\"map.resolution\" = 1\nmap = { resolution = 2 }",
+                "",
+                "[set]: `map.resolution` is written twice",
+            ),
+            (
+                "\"uav.0.behaviour.strategy\" = \"tour\"",
+                "\"uav[0].behaviour.strategy\" = [\"eaae\"]",
+                "`uav.0.behaviour.strategy` is in both [set] and [grid]",
+            ),
+            (
+                // A table in [set] sets its fields one by one.
+                "\"uav.0.behaviour\" = { strategy = \"tour\" }",
+                "\"uav.0.behaviour.strategy\" = [\"eaae\"]",
+                "`uav.0.behaviour.strategy` is in both [set] and [grid]",
+            ),
+            (
+                "\"uav.0.behaviour.speed\" = 2.0",
+                "\"uav.0.behaviour\" = [{ kind = \"explore\" }]",
+                "[set] `uav.0.behaviour.speed` lies inside [grid] `uav.0.behaviour`",
+            ),
+            (
+                "",
+                "\"uav.0\" = [{ name = \"a\" }]\n\"uav.0.name\" = [\"b\"]\n\"uav.1\" = [{}]",
+                "[grid] `uav.0.name` lies inside [grid] `uav.0`",
+            ),
+        ];
+        for (set, grid, expected) in cases {
+            let error = plan(set, grid).expect_err(expected);
+            assert!(error.contains(expected), "{expected}: {error}");
+        }
+        // Neighbours that only share a beginning are different places, and so are the
+        // other fields of a table in [set].
+        let accepted = plan(
+            "\"uav.0.behaviour.speed\" = 2.0\n\"uav.0.behaviour.speeds\" = 1.0\n\
+             \"uav.0.behaviour\" = { kind = \"explore\" }",
+            "\"uav.0.behaviour.strategy\" = [\"eaae\"]\n\"uav.1.behaviour\" = [{}]",
+        );
+        assert!(accepted.is_ok(), "{accepted:?}");
     }
 }

@@ -93,13 +93,24 @@ impl<'g> TargetPaths<'g> {
         let mut goals = Vec::new();
         for &target in which {
             if !std::mem::replace(&mut self.reached[target], true) {
-                let end = self.first_goal.get(target + 1).copied();
-                goals.extend(self.first_goal[target]..end.unwrap_or(self.paths.len()));
+                goals.extend(self.goals_of(target));
             }
         }
         for (goal, path) in goals.iter().zip(self.search.paths(&goals)) {
             self.paths[*goal] = path;
         }
+    }
+
+    /// The indices of target `target`'s goals, in [`target_goals`] order.
+    fn goals_of(&self, target: usize) -> std::ops::Range<usize> {
+        let end = self.first_goal.get(target + 1).copied();
+        self.first_goal[target]..end.unwrap_or(self.paths.len())
+    }
+
+    /// The paths to target `target`'s goals, in [`target_goals`] order (`None` for a goal
+    /// not reached, or whose target was not searched for yet).
+    fn paths_of(&self, target: usize) -> &[Option<Vec<DVec3>>] {
+        &self.paths[self.goals_of(target)]
     }
 }
 
@@ -128,10 +139,9 @@ pub fn plan_targets(
         .map_init(
             || SightMemo::new(grid),
             |sight, &index| {
-                let first = paths.first_goal[index];
-                let mut goals = target_goals(&targets[index]).enumerate();
-                goals.find_map(|(k, goal)| {
-                    let path = paths.paths[first + k].as_ref()?;
+                let mut goals = target_goals(&targets[index]).zip(paths.paths_of(index));
+                goals.find_map(|(goal, path)| {
+                    let path = path.as_ref()?;
                     if goal.position.distance(start.position) <= min_travel_m {
                         return None;
                     }

@@ -1,10 +1,15 @@
 //! No input makes the scenario loader panic: random bytes, random TOML-like text and random
 //! mutations of the shipped scenarios either load or give diagnostics placed inside the file.
+//! Nor the sweep plan reader: mutations of the shipped plans are read or refused with a
+//! message, and a plan read expands into as many runs as it counts, each with its own id.
 
+use std::collections::BTreeSet;
 use std::path::Path;
 
 use proptest::prelude::*;
 use uavex_engine::scenario::{ScenarioErrors, load, parse_str};
+use uavex_engine::sweep::expand::expand;
+use uavex_engine::sweep::plan::Plan;
 
 const SHIPPED: &[&str] = &[
     include_str!("../../scenarios/eaae_pillars.toml"),
@@ -12,6 +17,13 @@ const SHIPPED: &[&str] = &[
     include_str!("../../scenarios/pillars_scripted.toml"),
     include_str!("../../scenarios/examples/all_obstacles.toml"),
     include_str!("../../scenarios/examples/lidar.toml"),
+];
+
+const SHIPPED_PLANS: &[&str] = &[
+    include_str!("../../scenarios/eaae_protocol.toml"),
+    include_str!("../../scenarios/tour_comparison.toml"),
+    include_str!("../../docs/sweep_demo.toml"),
+    include_str!("../../pgo/training.toml"),
 ];
 
 /// Every diagnostic is inside the text: line 1 ..= lines + 1, column from 1.
@@ -195,6 +207,31 @@ proptest! {
     ) {
         let text = mutations.iter().fold(SHIPPED[which].to_owned(), |text, m| apply(&text, m));
         check_text(&text);
+    }
+
+    #[test]
+    fn mutated_shipped_plans_are_read_or_refused(
+        which in 0..SHIPPED_PLANS.len(),
+        mutations in proptest::collection::vec(mutation(), 1..6),
+    ) {
+        let text = mutations
+            .iter()
+            .fold(SHIPPED_PLANS[which].to_owned(), |text, m| apply(&text, m));
+        match Plan::parse(&text, Path::new("plans/fuzz.toml")) {
+            Err(error) => {
+                let message = error.to_string();
+                prop_assert!(message.starts_with("plans/fuzz.toml: "), "{message}");
+                prop_assert!(message.len() > "plans/fuzz.toml: ".len());
+            }
+            // Expanding a plan at the run limit takes seconds: mutated digits make a few.
+            Ok(plan) if plan.run_count() <= 100_000 => {
+                let runs = expand(&plan);
+                prop_assert_eq!(runs.len(), plan.run_count());
+                let ids: BTreeSet<&str> = runs.iter().map(|run| run.id.as_str()).collect();
+                prop_assert_eq!(ids.len(), runs.len(), "two runs share an id");
+            }
+            Ok(_) => {}
+        }
     }
 }
 

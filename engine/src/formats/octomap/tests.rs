@@ -40,6 +40,16 @@ fn header_is_octomaps() {
     );
 }
 
+/// Every key's bits land where the interleaving puts them: bit `b` at bit `3b`, for all 2^16
+/// keys, against the definition bit by bit.
+#[test]
+fn spread_bits_moves_bit_b_to_bit_3b() {
+    for k in 0..=u16::MAX {
+        let by_bit: u64 = (0..16).map(|b| u64::from((k >> b) & 1) << (3 * b)).sum();
+        assert_eq!(spread_bits(k), by_bit, "key {k:#06x}");
+    }
+}
+
 /// Voxel (0,0,0) has OctoMap key 32768 = 0b1000_0000_0000_0000 on each axis: child 7 at the
 /// root (bit 15 set on x, y, z), then child 0 for 15 levels. Root: child 7 inner -> second byte
 /// bits 6-7 = 0b11 -> 0xC0. Depths 1-14: child 0 inner -> 0x03. Depth 15: child 0 occupied

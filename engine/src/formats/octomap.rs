@@ -92,15 +92,15 @@ fn morton_code(voxel: IVec3) -> io::Result<u64> {
     Ok(spread_bits(x) | spread_bits(y) << 1 | spread_bits(z) << 2)
 }
 
-/// The 16 bits of `k` moved to every third bit (bit `b` to bit `3b`), in halving steps: each
-/// moves the upper half of every group of bits away from its lower half, then masks.
+/// The 16 bits of `k` moved to every third bit (bit `b` to bit `3b`), in halving steps: the
+/// bytes apart (each byte's bits to `24 (b / 8) + b % 8`), then the nibbles, the pairs and
+/// the bits, each step shifting every group's upper half away and masking its old place out.
 fn spread_bits(k: u16) -> u64 {
     let mut v = u64::from(k);
-    v = (v | v << 32) & 0x001f_0000_0000_ffff;
-    v = (v | v << 16) & 0x001f_0000_ff00_00ff;
-    v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
-    v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
-    v = (v | v << 2) & 0x1249_2492_4924_9249;
+    v = (v | v << 16) & 0x0000_0000_ff00_00ff;
+    v = (v | v << 8) & 0x0000_00f0_0f00_f00f;
+    v = (v | v << 4) & 0x0000_0c30_c30c_30c3;
+    v = (v | v << 2) & 0x0000_2492_4924_9249;
     v
 }
 

@@ -51,10 +51,12 @@ impl LocalProjection {
         (m, n * phi.cos())
     }
 
+    /// The point at `lon`, `lat` (degrees), its longitude taken the short way round from the
+    /// origin's (so a field across the antimeridian stays in one piece).
     pub fn to_metres(&self, lon: f64, lat: f64) -> DVec2 {
         let (m, n_cos) = self.radii();
         DVec2::new(
-            n_cos * (lon - self.origin_lon).to_radians(),
+            n_cos * (nearest_turn(lon, self.origin_lon) - self.origin_lon).to_radians(),
             m * (lat - self.origin_lat).to_radians(),
         )
     }
@@ -63,9 +65,22 @@ impl LocalProjection {
     pub fn to_lonlat(&self, p: DVec2) -> (f64, f64) {
         let (m, n_cos) = self.radii();
         (
-            self.origin_lon + (p.x / n_cos).to_degrees(),
+            nearest_turn(self.origin_lon + (p.x / n_cos).to_degrees(), 0.0),
             self.origin_lat + (p.y / m).to_degrees(),
         )
+    }
+}
+
+/// `lon` (degrees), or the same meridian a turn nearer to `reference` when it lies half a turn
+/// or more from it; unchanged, to the bit, nearer than that.
+fn nearest_turn(lon: f64, reference: f64) -> f64 {
+    let offset = lon - reference;
+    if offset >= 180.0 {
+        lon - 360.0
+    } else if offset < -180.0 {
+        lon + 360.0
+    } else {
+        lon
     }
 }
 
@@ -110,10 +125,18 @@ pub fn read_field(path: &Path, coordinates: Option<Coordinates>) -> Result<Field
                     bad.x, bad.y
                 )));
             }
+            // The centre of the vertices as they lie together: a longitude more than half a
+            // turn from the first vertex's is the same meridian a turn nearer (a field across
+            // the antimeridian has vertices near 180 and near -180 degrees).
+            let first = ring.first().map_or(0.0, |p| p.x);
             let n = ring.len().max(1) as f64;
-            let centre = ring.iter().copied().sum::<DVec2>() / n;
+            let centre = ring
+                .iter()
+                .map(|&p| DVec2::new(nearest_turn(p.x, first), p.y))
+                .sum::<DVec2>()
+                / n;
             let projection = LocalProjection {
-                origin_lon: centre.x,
+                origin_lon: nearest_turn(centre.x, 0.0),
                 origin_lat: centre.y,
             };
             Ok(Field {
@@ -294,6 +317,40 @@ mod tests {
         let height = field.vertices[1].distance(field.vertices[2]);
         assert!((width - 157.69).abs() < 0.05, "{width}");
         assert!((height - 111.13).abs() < 0.05, "{height}");
+    }
+
+    /// A field across the antimeridian (Taveuni, Fiji, lies on it) keeps its shape: its vertices
+    /// in metres are those of the same field across the prime meridian, and the plan's points
+    /// go back to longitudes on either side of 180 degrees.
+    #[test]
+    fn a_field_across_the_antimeridian_stays_in_one_piece() {
+        let dir = tempfile::tempdir().unwrap();
+        let polygon = |west: f64, east: f64| {
+            format!(
+                r#"{{"type": "Polygon", "coordinates": [[[{west}, -16.8], [{east}, -16.8],
+                   [{east}, -16.799], [{west}, -16.799], [{west}, -16.8]]]}}"#
+            )
+        };
+        let across =
+            read_field(&file(&dir, "a.geojson", &polygon(179.999, -179.999)), None).unwrap();
+        let at_zero = read_field(&file(&dir, "z.geojson", &polygon(-0.001, 0.001)), None).unwrap();
+        for (a, z) in across.vertices.iter().zip(&at_zero.vertices) {
+            assert!(a.distance(*z) < 1e-6, "{a} against {z}");
+        }
+        // 0.002 degrees of longitude at 16.8 degrees south: some 213 m, not a turn of the Earth.
+        let width = across.vertices[0].distance(across.vertices[1]);
+        assert!((width - 213.3).abs() < 0.5, "{width}");
+        let projection = across.projection.unwrap();
+        assert!(
+            (projection.origin_lon.abs() - 180.0).abs() < 1e-9,
+            "{projection:?}"
+        );
+        let (west, _) = projection.to_lonlat(across.vertices[0]);
+        let (east, _) = projection.to_lonlat(across.vertices[1]);
+        assert!(
+            (west - 179.999).abs() < 1e-9 && (east + 179.999).abs() < 1e-9,
+            "{west} {east}"
+        );
     }
 
     #[test]

@@ -12,6 +12,7 @@ use std::process::ExitCode;
 use std::time::Duration;
 use uavex_components::sim::Outcome;
 use uavex_engine::run::{RunOptions, RunReport};
+use uavex_engine::sweep::FileKind;
 
 #[derive(Parser)]
 #[command(
@@ -220,7 +221,17 @@ fn command(command: Command) -> ExitCode {
             let loaded = match uavex_engine::scenario::load(&scenario) {
                 Ok(loaded) => loaded,
                 Err(errors) => {
-                    errln!("{errors}");
+                    // A plan read as a scenario fails on every key; say what it is instead.
+                    if FileKind::of_file(&scenario) == FileKind::Plan {
+                        errln!(
+                            "{}: a sweep plan (it lists [[scenario]] tables), not a scenario: \
+                             run it with `uavex sweep {} --out DIR`",
+                            scenario.display(),
+                            scenario.display()
+                        );
+                    } else {
+                        errln!("{errors}");
+                    }
                     return ExitCode::from(INVALID_INPUT);
                 }
             };
@@ -294,7 +305,17 @@ fn sweep_command(
     let plan = match Plan::load(plan_path) {
         Ok(plan) => plan,
         Err(e) => {
-            errln!("{e}");
+            // A scenario read as a plan fails on its first table; say what it is instead.
+            if FileKind::of_file(plan_path) == FileKind::Scenario {
+                errln!(
+                    "{}: a scenario (it lists [[uav]] tables), not a sweep plan: run it with \
+                     `uavex run {}`, or name it in a plan's [[scenario]] table (docs/sweeps.md)",
+                    plan_path.display(),
+                    plan_path.display()
+                );
+            } else {
+                errln!("{e}");
+            }
             return ExitCode::from(INVALID_INPUT);
         }
     };

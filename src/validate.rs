@@ -6,15 +6,14 @@ use crate::console::{errln, outln};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use uavex_engine::run::load_and_check;
-use uavex_engine::sweep::{Plan, check_plan, is_plan};
+use uavex_engine::sweep::{FileKind, Plan, check_plan};
 
 /// Checks each file of `paths`: a scenario as `uavex run` would load it, a sweep plan (a file
 /// with `[[scenario]]` tables) with each of its scenario variants; exit code 2 if any fails.
 pub fn validate_command(paths: &[PathBuf]) -> ExitCode {
     let mut all_valid = true;
     for path in paths {
-        let plan = std::fs::read_to_string(path).is_ok_and(|text| is_plan(&text));
-        if plan {
+        if FileKind::of_file(path) == FileKind::Plan {
             all_valid &= validate_plan(path);
             continue;
         }

@@ -28,4 +28,4 @@ pub use expand::{RunCoordinates, RunSpec, Shard, expand};
 pub use merge::{MergeReport, merge};
 pub use path::OverridePath;
 pub use plan::{Plan, PlanError};
-pub use validate::{PlanCheck, RefusedVariant, check_plan, is_plan};
+pub use validate::{FileKind, PlanCheck, RefusedVariant, check_plan};

@@ -79,28 +79,66 @@ fn describe(run: &RunSpec) -> String {
         .join(", ")
 }
 
-/// Whether `text` is a sweep plan rather than a scenario: it lists `[[scenario]]` tables, a
-/// key no scenario has.
-pub fn is_plan(text: &str) -> bool {
-    text.parse::<toml::Table>()
-        .is_ok_and(|table| table.get("scenario").is_some_and(toml::Value::is_array))
+/// What a TOML file holds, told by the tables only one kind lists: a sweep plan
+/// `[[scenario]]`, a scenario `[[uav]]`. A file with neither (or not TOML) is neither, even if
+/// it means to be one: a scenario that misspells a table is a scenario with a problem.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum FileKind {
+    Plan,
+    Scenario,
+    Neither,
+}
+
+impl FileKind {
+    pub fn of(text: &str) -> Self {
+        let Ok(table) = text.parse::<toml::Table>() else {
+            return Self::Neither;
+        };
+        let lists = |key: &str| table.get(key).is_some_and(toml::Value::is_array);
+        if lists("scenario") {
+            Self::Plan
+        } else if lists("uav") {
+            Self::Scenario
+        } else {
+            Self::Neither
+        }
+    }
+
+    /// The kind of the file at `path` (`Neither` when it cannot be read).
+    pub fn of_file(path: &Path) -> Self {
+        std::fs::read_to_string(path).map_or(Self::Neither, |text| Self::of(&text))
+    }
 }
 
 #[cfg(test)]
 mod tests {
-    use super::is_plan;
+    use super::FileKind;
 
     #[test]
-    fn plans_are_told_from_scenarios_by_their_scenario_tables() {
-        assert!(is_plan("seeds = 2\n[[scenario]]\nfile = \"a.toml\"\n"));
-        assert!(is_plan(include_str!(
-            "../../../scenarios/eaae_protocol.toml"
-        )));
-        assert!(!is_plan(include_str!(
-            "../../../scenarios/eaae_pillars.toml"
-        )));
-        // A scenario that misspells a table is a scenario with a problem, not a plan.
-        assert!(!is_plan("name = \"x\"\n[scenario]\nfile = \"a.toml\"\n"));
-        assert!(!is_plan("not toml ["));
+    fn plans_and_scenarios_are_told_apart_by_their_tables() {
+        let kind = FileKind::of;
+        assert_eq!(
+            kind("seeds = 2\n[[scenario]]\nfile = \"a.toml\"\n"),
+            FileKind::Plan
+        );
+        assert_eq!(
+            kind(include_str!("../../../scenarios/eaae_protocol.toml")),
+            FileKind::Plan
+        );
+        assert_eq!(
+            kind(include_str!("../../../scenarios/eaae_pillars.toml")),
+            FileKind::Scenario
+        );
+        // A file that misspells the table of its kind is that kind with a problem, not the
+        // other kind: neither is told.
+        assert_eq!(
+            kind("name = \"x\"\n[scenario]\nfile = \"a.toml\"\n"),
+            FileKind::Neither
+        );
+        assert_eq!(
+            kind("name = \"x\"\n[uav]\nname = \"a\"\n"),
+            FileKind::Neither
+        );
+        assert_eq!(kind("not toml ["), FileKind::Neither);
     }
 }

@@ -165,6 +165,38 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
     assert!(explored >= 95.0, "{explored}");
 }
 
+/// A start nearer a face of the map than the planner's radius (here 0.20 m below the top of a
+/// scene without a ceiling) would leave no path from the start, and the run would end
+/// `complete` at once with the scene unexplored; it is refused when the run is built. The
+/// radius itself is fine: 0.33 m below the top, the UAV explores.
+#[test]
+fn a_start_within_the_planning_radius_of_the_map_is_refused() {
+    let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);
+    loaded.scenario.uavs[0].start.position = [0.0, 0.0, 2.3];
+    let Err(error) = Sim::build(&loaded, 1) else {
+        panic!("a start 0.20 m below the map's top was accepted");
+    };
+    let error = error.to_string();
+    assert!(
+        error.contains("uav[0].start.position")
+            && error.contains("planning radius, 0.320 m")
+            && error.contains("0.200 m from a face"),
+        "{error}"
+    );
+    loaded.scenario.uavs[0].start.position = [0.0, 0.0, 2.17];
+    loaded.scenario.time_limit_s = 12.0;
+    let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
+    let (outcome, reason) = sim.run_to_end();
+    assert_eq!(outcome, Outcome::TimeLimit, "{reason}");
+    let log = sim.world.resource::<DecisionLog>();
+    assert!(
+        log.decisions
+            .iter()
+            .any(|d| d.goal_kind == Some(GoalKind::Frontier)),
+        "{log:?}"
+    );
+}
+
 #[test]
 fn a_battery_limited_run_returns_home() {
     let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);

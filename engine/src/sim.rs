@@ -173,7 +173,7 @@ impl Sim {
                         physics,
                         explore,
                         world.resource::<WorldGeometry>(),
-                        scenario.map.resolution,
+                        world.resource::<MapConfig>(),
                     ) {
                         Ok((bundle, strategy)) => {
                             let mut entity = world.entity_mut(uav);

@@ -7,7 +7,7 @@ use crate::flight::{Physics, dynamic_flight};
 use crate::scenario::{SensorSpec, UavSpec};
 use crate::world::BuildError;
 use bevy_ecs::prelude::*;
-use glam::DVec3;
+use glam::{DVec3, IVec3};
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{
@@ -108,8 +108,9 @@ pub fn explorer_components(
     physics: &mut Physics,
     explore: &ExploreSpec,
     geometry: &WorldGeometry,
-    resolution: f64,
+    map: &MapConfig,
 ) -> Result<(impl Bundle + use<>, StrategyMarker), BuildError> {
+    let resolution = map.resolution();
     let camera = first_camera(spec).ok_or_else(|| {
         BuildError::new(
             format!("uav[{index}].sensor"),
@@ -139,6 +140,27 @@ pub fn explorer_components(
                  lies closer",
                 capsule.radius,
                 capsule.from.distance(capsule.to)
+            ),
+        ));
+    }
+    // The planner counts voxels outside the map as occupied (`TraversableGrid`): from a start
+    // nearer a face of the map than its inflation radius no path leaves the start, and every
+    // cluster would look unreachable (a run that ends `complete` at once).
+    let inflation = inflation_of(airframe);
+    let map_min = map.key_min().as_dvec3() * resolution;
+    let map_max = (map.key_max() + IVec3::ONE).as_dvec3() * resolution;
+    let clearance = (start - map_min).min(map_max - start).min_element();
+    if clearance < inflation {
+        let corner = |p: DVec3| format!("({:.2}, {:.2}, {:.2})", p.x, p.y, p.z);
+        return Err(BuildError::new(
+            format!("uav[{index}].start.position"),
+            format!(
+                "an exploring UAV must start at least its planning radius, {inflation:.3} m \
+                 (its body and the planner's margin), inside the map ({} to {}: world.bounds \
+                 on voxel faces), since the planner counts what lies outside the map as \
+                 occupied; this start is {clearance:.3} m from a face",
+                corner(map_min),
+                corner(map_max)
             ),
         ));
     }

@@ -290,19 +290,24 @@ fn validate_checks_every_scenario_variant_of_a_plan() {
 #[test]
 fn run_and_sweep_name_a_file_of_the_other_kind() {
     let dir = room_plan(1, "");
-    let (code, _, err) = uavex(dir.path(), &["run", "plan.toml", "--out", "out"]);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("plan.toml: a sweep plan") && err.contains("`uavex sweep plan.toml"),
-        "{err}"
-    );
-    assert!(!err.contains("unknown field"), "{err}");
-    let (code, _, err) = uavex(dir.path(), &["sweep", "room.toml", "--out", "out"]);
-    assert_eq!(code, Some(2), "{err}");
-    assert!(
-        err.contains("room.toml: a scenario") && err.contains("`uavex run room.toml`"),
-        "{err}"
-    );
-    assert!(!err.contains("unknown field"), "{err}");
+    for (command, file, kind, advice) in [
+        (
+            "run",
+            "plan.toml",
+            "plan.toml: a sweep plan",
+            "`uavex sweep plan.toml",
+        ),
+        (
+            "sweep",
+            "room.toml",
+            "room.toml: a scenario",
+            "`uavex run room.toml`",
+        ),
+    ] {
+        let (code, _, err) = uavex(dir.path(), &[command, file, "--out", "out"]);
+        assert_eq!(code, Some(2), "{err}");
+        assert!(err.contains(kind) && err.contains(advice), "{err}");
+        assert!(!err.contains("unknown field"), "{err}");
+    }
     assert!(!dir.path().join("out").exists(), "refused before any work");
 }

@@ -197,6 +197,29 @@ fn a_start_within_the_planning_radius_of_the_map_is_refused() {
     );
 }
 
+/// Exploration starts whatever the UAV's heading at its start, not only along the map's axes.
+/// The planner's lattice forbids cutting corners, so the stretch ahead of the start taken as
+/// free must be wide enough for a diagonal chain of lattice cells; with a core one cell wide,
+/// every heading more than about 0.2 rad off an axis ended `complete` after 3 s, unexplored.
+#[test]
+fn exploration_starts_from_headings_off_the_axes() {
+    let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);
+    loaded.scenario.time_limit_s = 8.0;
+    for yaw in [0.2618, 0.7854, 2.3562, -0.7854, -2.0944] {
+        loaded.scenario.uavs[0].start.yaw = yaw;
+        let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
+        let (outcome, reason) = sim.run_to_end();
+        assert_eq!(outcome, Outcome::TimeLimit, "yaw {yaw}: {reason}");
+        let log = sim.world.resource::<DecisionLog>();
+        assert!(
+            log.decisions
+                .iter()
+                .any(|d| d.goal_kind == Some(GoalKind::Frontier)),
+            "yaw {yaw}: {log:?}"
+        );
+    }
+}
+
 #[test]
 fn a_battery_limited_run_returns_home() {
     let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);

@@ -64,10 +64,14 @@ fn first_camera(spec: &UavSpec) -> Option<CameraView> {
 /// (`TraversableGrid::assume_free_ball` along it): a capsule from the start along its heading.
 ///
 /// Why: the planner keeps the whole inflated body in known free space, on a lattice of 2-voxel
-/// cells, and a forward camera sees a tube that wide only from `(inflation + 2 voxels) /
-/// tan(vfov / 2)` ahead; beside and below the UAV it sees nothing. Without this, the first
-/// decision finds the UAV boxed in. The scenario must keep the capsule clear of obstacles
-/// (checked when the run is built), as a take-off area is kept clear.
+/// cells, and a forward camera sees a tube that wide only from `radius / tan(vfov / 2)` ahead;
+/// beside and below the UAV it sees nothing. Without this, the first decision finds the UAV
+/// boxed in. The radius leaves a core two lattice cells wide around the axis once the body is
+/// taken off (`inflation + 4 voxels`): the lattice forbids cutting corners, so a chain of cells
+/// along a heading off the axes needs the cells beside it, and a one-cell core (`inflation + 2
+/// voxels`) connected the start to nothing for every heading more than about 0.2 rad off an
+/// axis. The scenario must keep the capsule clear of obstacles (checked when the run is built),
+/// as a take-off area is kept clear.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StartCapsule {
     pub from: DVec3,
@@ -77,7 +81,8 @@ pub struct StartCapsule {
 
 impl StartCapsule {
     pub fn new(start: DVec3, yaw: f64, vfov: f64, inflation: f64, resolution: f64) -> Self {
-        let radius = inflation + 2.0 * resolution;
+        // Two lattice cells of 2 voxels each beyond the body (see the type's comment).
+        let radius = inflation + 4.0 * resolution;
         let length = radius / (vfov / 2.0).tan().max(1e-3) + resolution;
         Self {
             from: start,

@@ -205,7 +205,14 @@ fn a_start_within_the_planning_radius_of_the_map_is_refused() {
 fn exploration_starts_from_headings_off_the_axes() {
     let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);
     loaded.scenario.time_limit_s = 8.0;
-    for yaw in [0.2618, 0.7854, 2.3562, -0.7854, -2.0944] {
+    use std::f64::consts::{FRAC_PI_4, PI};
+    for yaw in [
+        PI / 12.0,
+        FRAC_PI_4,
+        3.0 * FRAC_PI_4,
+        -FRAC_PI_4,
+        -2.0 * PI / 3.0,
+    ] {
         loaded.scenario.uavs[0].start.yaw = yaw;
         let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
         let (outcome, reason) = sim.run_to_end();

@@ -17,8 +17,14 @@
 //! that must reverse the start's motion within one long segment runs on the way the UAV went.
 //! The local planner does so only when it finds no other trajectory.
 //!
-//! Headings face the direction of travel at every waypoint (the depth camera looks forward,
-//! where the UAV is going), and `end_yaw` at the end when given.
+//! Headings: the heading turns smoothly from the start's to `end_yaw` (without one, to the
+//! direction of the path's last leg); the waypoints between leave it free, and the time
+//! allocation holds its rate within `max_yaw_rate`. Facing the direction of travel at every
+//! waypoint was the rule before: where a path turns back, neighbouring waypoints a short hop
+//! apart then differ in heading by pi. Without a rate limit the heading's polynomial overshot
+//! there (a reference turning at 9 rad/s made a UAV spin and crash in the EAAE protocol); with
+//! the limit those turns stretched the trajectories, and the protocol's missions took up to
+//! 8 % longer (docs/performance.md, forty-eighth session).
 
 use super::braking::{Braking, BrakingMemo};
 use super::check::first_untraversable;
@@ -240,16 +246,18 @@ fn fit(
     let max_insertions = 4 * original.len() + 15;
     let mut added = 0;
     loop {
-        let mut yaws = follow_headings(start.position, start.yaw, &positions);
-        if let (Some(yaw), Some(last)) = (end_yaw, yaws.last_mut()) {
-            *last = yaw;
-        }
+        // The heading is fixed at the end only (module doc).
+        let end_heading = end_yaw.or_else(|| {
+            follow_headings(start.position, start.yaw, &positions)
+                .last()
+                .copied()
+        });
         let waypoints: Vec<Waypoint> = positions
             .iter()
-            .zip(&yaws)
-            .map(|(&position, &yaw)| Waypoint {
+            .enumerate()
+            .map(|(i, &position)| Waypoint {
                 position,
-                yaw: Some(yaw),
+                yaw: end_heading.filter(|_| i + 1 == positions.len()),
             })
             .collect();
         let trajectory = plan_min_snap(start, &waypoints, limits)?;

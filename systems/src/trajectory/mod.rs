@@ -9,6 +9,7 @@ pub mod limits;
 pub mod min_snap;
 pub mod planner;
 pub mod retime;
+pub mod yaw_rate;
 
 #[cfg(test)]
 mod tests;

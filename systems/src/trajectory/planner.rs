@@ -4,8 +4,9 @@
 //! Time allocation: each segment starts with the time a rest-to-rest trapezoidal profile at
 //! (vmax, amax) would take over its straight length (and enough to turn the yaw at
 //! `max_yaw_rate`), which sets the segments' proportions. The minimum-snap solution then gets
-//! its exact peaks ([`super::limits`]), and every duration is scaled until the worst excess
-//! ratio `max(v/vmax, sqrt(a/amax))` is just within 1 ([`super::retime`]). Uniform scaling
+//! its exact peaks ([`super::limits`], [`super::yaw_rate`]), and every duration is scaled
+//! until the worst excess ratio `max(v/vmax, sqrt(a/amax), yaw rate/max_yaw_rate)` is just
+//! within 1 ([`super::retime`]). Uniform scaling
 //! keeps the shape of the path: from rest, speed scales as 1/s and acceleration as 1/s^2
 //! exactly, so one round lands on the binding limit; from a moving start (whose velocity does
 //! not scale) a secant search takes a few. A solution slower than needed is tightened the
@@ -29,8 +30,9 @@
 use super::PlanError;
 use super::collision::first_blocked;
 use super::limits::worst_ratio;
-use super::min_snap::{JointConstraints, build_segments, solve_joint_derivatives, solve_outputs};
+use super::min_snap::{JointConstraints, build_segments, solve_outputs};
 use super::retime::{MARGIN, ScaleSearch, Step};
+use super::yaw_rate::yaw_rate_ratio;
 use glam::DVec3;
 use std::f64::consts::{PI, TAU};
 use uavex_components::airframe::Airframe;
@@ -59,25 +61,36 @@ pub struct DynamicLimits {
     pub max_velocity: f64,
     /// m/s^2.
     pub max_acceleration: f64,
-    /// rad/s, used for the time allocation of heading changes only.
+    /// rad/s: the heading's rate, a limit like the other two (see [`super::yaw_rate`] for
+    /// what a reference turning faster than the yaw loop follows does).
     pub max_yaw_rate: f64,
 }
 
 impl DynamicLimits {
     /// The airframe's planning limits (EAAE Table 5.1 for the kingfisher) and a yaw rate of
-    /// 1 rad/s, which the slow yaw loop (kp_att_z = 3) follows.
+    /// 2 rad/s, which the slow yaw loop (kp_att_z = 3) follows. Why 2: over three EAAE
+    /// missions (Simple nearest seed 5, Pillars eaae seed 1, Simple classic seed 2) the
+    /// position stayed within 5 cm of the reference at 1 and at 2 rad/s (yaw within 0.4 and
+    /// 0.7 rad); at 3 rad/s it strayed 1 m in one mission. At 1 rad/s the nearest strategy's
+    /// short hops, each with a turn of up to pi, took so long that one mission ran its battery
+    /// empty (docs/performance.md, forty-eighth session).
     pub fn of(airframe: &Airframe) -> Self {
         Self {
             max_velocity: airframe.max_velocity,
             max_acceleration: airframe.max_acceleration,
-            max_yaw_rate: 1.0,
+            max_yaw_rate: 2.0,
         }
     }
 
-    /// The largest `max(v / vmax, sqrt(a / amax))` over `trajectory` when above `floor`
-    /// ([`worst_ratio`]).
-    fn worst_ratio(&self, trajectory: &PiecewisePolynomial, floor: f64) -> f64 {
-        worst_ratio(trajectory, self.max_velocity, self.max_acceleration, floor)
+    /// The largest `max(v / vmax, sqrt(a / amax), yaw rate / max_yaw_rate)` over
+    /// `trajectory` when above `floor` ([`worst_ratio`], [`yaw_rate_ratio`]).
+    pub fn worst_ratio(&self, trajectory: &PiecewisePolynomial, floor: f64) -> f64 {
+        let motion = worst_ratio(trajectory, self.max_velocity, self.max_acceleration, floor);
+        motion.max(yaw_rate_ratio(
+            trajectory,
+            self.max_yaw_rate,
+            motion.max(floor),
+        ))
     }
 
     fn check(&self) -> Result<(), PlanError> {
@@ -108,9 +121,14 @@ pub fn plan_min_snap(
     check_inputs(start, waypoints)?;
     let speed0 = start.velocity.length();
     let acceleration0 = start.acceleration.length();
-    if speed0 > limits.max_velocity * MARGIN || acceleration0 > limits.max_acceleration * MARGIN {
+    let yaw_rate0 = start.yaw_rate.abs();
+    if speed0 > limits.max_velocity * MARGIN
+        || acceleration0 > limits.max_acceleration * MARGIN
+        || yaw_rate0 > limits.max_yaw_rate * MARGIN
+    {
         return Err(PlanError::StartExceedsLimits(format!(
-            "speed {speed0:.3} m/s, acceleration {acceleration0:.3} m/s^2"
+            "speed {speed0:.3} m/s, acceleration {acceleration0:.3} m/s^2, yaw rate \
+             {yaw_rate0:.3} rad/s"
         )));
     }
     let yaws = unwrapped_yaws(start.yaw, waypoints);
@@ -143,14 +161,12 @@ fn allocate(
     let mut durations = initial_durations(start, waypoints, yaws, limits)?;
     let mut search = ScaleSearch::new();
     for _ in 0..MAX_ROUNDS {
-        let mut outputs = solve_position(start, waypoints, &durations, jerk)?;
-        let worst = limits.worst_ratio(&trajectory_of(&durations, &outputs)?, 0.0);
+        let trajectory = solve(start, waypoints, yaws, &durations, jerk)?;
+        let worst = limits.worst_ratio(&trajectory, 0.0);
         match search.step(worst) {
             Step::Accept => {
-                return match tighten(start, waypoints, yaws, &durations, worst, limits, jerk) {
-                    Some(tightened) => Ok(Some(tightened)),
-                    None => with_yaw(start, yaws, &durations, &mut outputs).map(Some),
-                };
+                let tightened = tighten(start, waypoints, yaws, &durations, worst, limits, jerk);
+                return Ok(Some(tightened.unwrap_or(trajectory)));
             }
             Step::Scale(factor) => durations.iter_mut().for_each(|d| *d *= factor),
             Step::GiveUp => break,
@@ -174,9 +190,8 @@ fn tighten(
         return None;
     }
     let scaled: Vec<f64> = durations.iter().map(|d| d * worst * MARGIN).collect();
-    let mut outputs = solve_position(start, waypoints, &scaled, jerk).ok()?;
-    let within = limits.worst_ratio(&trajectory_of(&scaled, &outputs).ok()?, 1.0) <= 1.0;
-    within.then(|| with_yaw(start, yaws, &scaled, &mut outputs).ok())?
+    let trajectory = solve(start, waypoints, yaws, &scaled, jerk).ok()?;
+    (limits.worst_ratio(&trajectory, 1.0) <= 1.0).then_some(trajectory)
 }
 
 /// Minimum-snap trajectory with given segment durations (no limits enforced).
@@ -195,7 +210,7 @@ pub fn min_snap_with_durations(
         )));
     }
     let yaws = unwrapped_yaws(start.yaw, waypoints);
-    solve_with_durations(start, waypoints, &yaws, durations)
+    solve(start, waypoints, &yaws, durations, StartJerk::Held)
 }
 
 /// Like [`plan_min_snap`], and free of `blocked` points (sampled every `spacing` metres along
@@ -328,70 +343,54 @@ fn initial_durations(
     Ok(durations)
 }
 
-/// The minimum-snap trajectory for the given durations, headings included.
-fn solve_with_durations(
+/// The minimum-snap trajectory for the given durations: x, y, z and the heading, the start's
+/// jerk as `jerk` says (the heading's start jerk is zero when held, as its start has none; free
+/// with the position's, so that the four outputs share one factorisation whenever every
+/// waypoint has a heading).
+fn solve(
     start: &TrajectoryPoint,
     waypoints: &[Waypoint],
     yaws: &[Option<f64>],
-    durations: &[f64],
-) -> Result<PiecewisePolynomial, PlanError> {
-    let mut outputs = solve_position(start, waypoints, durations, StartJerk::Held)?;
-    with_yaw(start, yaws, durations, &mut outputs)
-}
-
-/// The joint derivatives of x, y and z for the given durations (one factorisation serves the
-/// three), yaw left at zero: the limits and the collision checks read positions only, so the
-/// re-timing rounds need not solve the heading. The start's jerk as `jerk` says.
-fn solve_position(
-    start: &TrajectoryPoint,
-    waypoints: &[Waypoint],
     durations: &[f64],
     jerk: StartJerk,
-) -> Result<[Vec<[f64; 4]>; 4], PlanError> {
+) -> Result<PiecewisePolynomial, PlanError> {
     let last = waypoints.len();
-    let axes: Vec<JointConstraints> = (0..3)
+    let held = jerk == StartJerk::Held;
+    let joints = |start_values: [Option<f64>; 4], at: &dyn Fn(usize) -> Option<f64>| {
+        let mut values = Vec::with_capacity(last + 1);
+        values.push(start_values);
+        for i in 0..last {
+            let at_rest = if i + 1 == last { Some(0.0) } else { None };
+            values.push([at(i), at_rest, at_rest, at_rest]);
+        }
+        JointConstraints { values }
+    };
+    let mut outputs: Vec<JointConstraints> = (0..3)
         .map(|axis| {
-            let mut values = Vec::with_capacity(last + 1);
-            values.push([
-                Some(start.position[axis]),
-                Some(start.velocity[axis]),
-                Some(start.acceleration[axis]),
-                (jerk == StartJerk::Held).then_some(start.jerk[axis]),
-            ]);
-            for (i, w) in waypoints.iter().enumerate() {
-                let at_rest = if i + 1 == last { Some(0.0) } else { None };
-                values.push([Some(w.position[axis]), at_rest, at_rest, at_rest]);
-            }
-            JointConstraints { values }
+            joints(
+                [
+                    Some(start.position[axis]),
+                    Some(start.velocity[axis]),
+                    Some(start.acceleration[axis]),
+                    held.then_some(start.jerk[axis]),
+                ],
+                &|i| Some(waypoints[i].position[axis]),
+            )
         })
         .collect();
-    let [x, y, z]: [Vec<[f64; 4]>; 3] = solve_outputs(durations, &axes)?
+    outputs.push(joints(
+        [
+            Some(start.yaw),
+            Some(start.yaw_rate),
+            Some(start.yaw_acceleration),
+            held.then_some(0.0),
+        ],
+        &|i| yaws[i],
+    ));
+    let [x, y, z, yaw]: [Vec<[f64; 4]>; 4] = solve_outputs(durations, &outputs)?
         .try_into()
-        .expect("three axes solved");
-    Ok([x, y, z, vec![[0.0; 4]; last + 1]])
-}
-
-/// Fills in the heading of [`solve_position`]'s outputs and builds the trajectory.
-fn with_yaw(
-    start: &TrajectoryPoint,
-    yaws: &[Option<f64>],
-    durations: &[f64],
-    outputs: &mut [Vec<[f64; 4]>; 4],
-) -> Result<PiecewisePolynomial, PlanError> {
-    let last = yaws.len();
-    let mut values = Vec::with_capacity(last + 1);
-    values.push([
-        Some(start.yaw),
-        Some(start.yaw_rate),
-        Some(start.yaw_acceleration),
-        Some(0.0),
-    ]);
-    for (i, yaw) in yaws.iter().enumerate() {
-        let at_rest = if i + 1 == last { Some(0.0) } else { None };
-        values.push([*yaw, at_rest, at_rest, at_rest]);
-    }
-    outputs[3] = solve_joint_derivatives(durations, &JointConstraints { values })?;
-    trajectory_of(durations, outputs)
+        .expect("four outputs solved");
+    trajectory_of(durations, &[x, y, z, yaw])
 }
 
 /// The trajectory of the given joint derivatives.

@@ -2,7 +2,7 @@
 //! limit is just met (Richter, Bry & Roy 2013, §III-C: scale the time until the limits hold).
 //!
 //! Let `s` scale every duration and `r(s)` be the trajectory's worst excess ratio
-//! `max(v/vmax, sqrt(a/amax))` (`super::limits`). From rest `r` falls exactly as `1/s`, so the
+//! `max(v/vmax, sqrt(a/amax), yaw rate/max_yaw_rate)` (`super::limits`, `super::yaw_rate`). From rest `r` falls exactly as `1/s`, so the
 //! fixed-point step `s <- s r(s)` lands on `r = 1` in one round. From a moving start it does
 //! not: the start velocity, acceleration and jerk do not scale with the durations, `r` falls
 //! more slowly than `1/s`, and the fixed-point steps creep toward the limit (ratios 1.27,

@@ -30,12 +30,22 @@ fn tour() -> Vec<Waypoint> {
 
 /// Largest speed and acceleration over dense samples.
 fn sampled_peaks(trajectory: &PiecewisePolynomial, per_segment: usize) -> (f64, f64) {
-    let mut peaks: (f64, f64) = (0.0, 0.0);
+    let (v, a, _) = sampled_peaks_with_yaw_rate(trajectory, per_segment);
+    (v, a)
+}
+
+/// Largest speed, acceleration and |yaw rate| over dense samples.
+fn sampled_peaks_with_yaw_rate(
+    trajectory: &PiecewisePolynomial,
+    per_segment: usize,
+) -> (f64, f64, f64) {
+    let mut peaks: (f64, f64, f64) = (0.0, 0.0, 0.0);
     for segment in trajectory.segments() {
         for i in 0..=per_segment {
             let p = segment.point(i as f64 / per_segment as f64);
             peaks.0 = peaks.0.max(p.velocity.length());
             peaks.1 = peaks.1.max(p.acceleration.length());
+            peaks.2 = peaks.2.max(p.yaw_rate.abs());
         }
     }
     peaks
@@ -112,6 +122,51 @@ fn moving_start_is_kept() {
         v <= 5.0 * (1.0 + 1e-9) && a <= 4.0 * (1.0 + 1e-9),
         "{v} {a}"
     );
+}
+
+/// A path that turns back on itself, headed along its legs as the exploration planner heads it
+/// (`follow_headings`), from a start already turning: neighbouring waypoints a short hop apart
+/// differ in heading by pi. The heading's polynomial used to overshoot there to several times
+/// `max_yaw_rate` (a reference turning at 9 rad/s made a UAV spin and crash); the time
+/// allocation now holds the yaw rate like the speed and acceleration.
+#[test]
+fn a_path_turning_back_keeps_the_yaw_rate_within_its_limit() {
+    let start = TrajectoryPoint {
+        position: DVec3::new(0.0, 6.0, 1.9),
+        velocity: DVec3::new(0.0, 0.25, -0.07),
+        yaw: 13.07,
+        yaw_rate: 0.9,
+        ..Default::default()
+    };
+    let positions = [
+        DVec3::new(0.0, 6.4, 1.8),
+        DVec3::new(0.1, 5.2, 1.2),
+        DVec3::new(0.1, 5.6, 1.3),
+        DVec3::new(0.0, 7.2, 1.8),
+        DVec3::new(-1.0, 8.6, 1.25),
+    ];
+    let headings =
+        crate::behaviour::waypoints::follow_headings(start.position, start.yaw, &positions);
+    let waypoints: Vec<Waypoint> = positions
+        .iter()
+        .zip(headings)
+        .map(|(&position, yaw)| Waypoint {
+            position,
+            yaw: Some(yaw),
+        })
+        .collect();
+    let limits = DynamicLimits {
+        max_yaw_rate: 2.0,
+        ..limits()
+    };
+    let trajectory = plan_min_snap(&start, &waypoints, &limits).unwrap();
+    let (v, a, yaw_rate) = sampled_peaks_with_yaw_rate(&trajectory, 2000);
+    assert!(
+        v <= 5.0 * (1.0 + 1e-9) && a <= 4.0 * (1.0 + 1e-9),
+        "{v} {a}"
+    );
+    assert!(yaw_rate <= 2.0 * (1.0 + 1e-9), "yaw rate {yaw_rate} rad/s");
+    assert!((trajectory.sample(0.0).yaw_rate - 0.9).abs() < 1e-12);
 }
 
 #[test]
@@ -200,30 +255,37 @@ fn collision_is_removed_by_inserting_midpoints() {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(64))]
 
-    /// Random tours in a 10 x 10 x 3 m box: the limits hold everywhere (dense sampling),
+    /// Random tours in a 10 x 10 x 3 m box, some waypoints with a heading: the limits (speed,
+/// acceleration, yaw rate) hold everywhere (dense sampling),
     /// every waypoint is passed, the end is at rest.
     #[test]
     fn random_tours_respect_the_limits(
         points in prop::collection::vec((-5.0f64..5.0, -5.0f64..5.0, 0.5f64..3.0), 1..7),
+        headings in prop::collection::vec(prop::option::of(-3.2f64..3.2), 7),
         vmax in 1.0f64..6.0,
         amax in 1.0f64..6.0,
+        max_yaw_rate in 0.5f64..3.0,
     ) {
         let start = TrajectoryPoint::at_rest(DVec3::new(0.0, 0.0, 1.0), 0.0);
         let mut waypoints = Vec::new();
         let mut previous = start.position;
-        for (x, y, z) in points {
+        for ((x, y, z), yaw) in points.into_iter().zip(headings) {
             let p = DVec3::new(x, y, z);
             if p.distance(previous) > 0.2 {
-                waypoints.push(Waypoint::new(p));
+                waypoints.push(Waypoint { position: p, yaw });
                 previous = p;
             }
         }
         prop_assume!(!waypoints.is_empty());
-        let limits = DynamicLimits { max_velocity: vmax, max_acceleration: amax, max_yaw_rate: 1.0 };
+        let limits = DynamicLimits { max_velocity: vmax, max_acceleration: amax, max_yaw_rate };
         let trajectory = plan_min_snap(&start, &waypoints, &limits).unwrap();
-        let (v, a) = sampled_peaks(&trajectory, 1000);
+        let (v, a, yaw_rate) = sampled_peaks_with_yaw_rate(&trajectory, 1000);
         prop_assert!(v <= vmax * (1.0 + 1e-9), "speed {} > {}", v, vmax);
         prop_assert!(a <= amax * (1.0 + 1e-9), "acceleration {} > {}", a, amax);
+        prop_assert!(
+            yaw_rate <= max_yaw_rate * (1.0 + 1e-9),
+            "yaw rate {} > {}", yaw_rate, max_yaw_rate
+        );
         for (segment, w) in trajectory.segments().iter().zip(&waypoints) {
             prop_assert!(segment.point(1.0).position.distance(w.position) < 1e-8);
         }

@@ -400,3 +400,28 @@ fn a_blocked_start_is_attached_to_the_nearest_open_cell() {
         None
     );
 }
+
+/// A start on traversable voxels whose nearest open cell lies beyond `SNAP_RADIUS_M` (a tube
+/// one voxel wide, as a pocket of traversable voxels between a wall and unobserved space is)
+/// joins the lattice at the nearest open cell it sees within `START_SEE_RADIUS_M`, over
+/// traversable voxels; before, no path left it.
+#[test]
+fn a_start_in_a_narrow_pocket_sees_its_way_to_the_lattice() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 1.6));
+    map.fill_all(OCCUPIED);
+    // A room x < 2.0 m, and a tube of single voxels from it along +x at y 3.0-3.1, z 0.8-0.9.
+    map.fill(IVec3::new(0, 0, 0), IVec3::new(19, 63, 15), FREE);
+    map.fill(IVec3::new(20, 30, 8), IVec3::new(26, 30, 8), FREE);
+    let grid = map.grid(0.0);
+    let start = DVec3::new(2.65, 3.05, 0.85);
+    let goal = DVec3::new(1.0, 3.0, 0.8);
+    assert!(grid.is_traversable_point(start));
+    // The nearest open cell's centre, (1.9, 3.1, 0.9), is 0.75 m away.
+    assert!(DVec3::new(1.9, 3.1, 0.9).distance(start) > SNAP_RADIUS_M);
+    let path = find_path(&grid, start, goal, usize::MAX).unwrap();
+    assert_eq!((path[0], *path.last().unwrap()), (start, goal));
+    assert!(path[1].distance(start) <= super::search::START_SEE_RADIUS_M);
+    assert!(path.windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    let paths = find_paths(&grid, start, &[goal], usize::MAX);
+    assert_eq!(paths[0].as_ref(), Some(&path));
+}

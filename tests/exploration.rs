@@ -185,15 +185,20 @@ fn a_start_within_the_planning_radius_of_the_map_is_refused() {
     );
     loaded.scenario.uavs[0].start.position = [0.0, 0.0, 2.17];
     loaded.scenario.time_limit_s = 12.0;
-    let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
+    assert_explores_until_the_time_limit(&loaded, "a start 0.33 m below the top");
+}
+
+/// Runs `loaded` (seed 1) to its time limit and asserts it got there flying to frontier.
+fn assert_explores_until_the_time_limit(loaded: &LoadedScenario, case: &str) {
+    let mut sim = Sim::build(loaded, 1).unwrap_or_else(|e| panic!("{case}: {e}"));
     let (outcome, reason) = sim.run_to_end();
-    assert_eq!(outcome, Outcome::TimeLimit, "{reason}");
+    assert_eq!(outcome, Outcome::TimeLimit, "{case}: {reason}");
     let log = sim.world.resource::<DecisionLog>();
     assert!(
         log.decisions
             .iter()
             .any(|d| d.goal_kind == Some(GoalKind::Frontier)),
-        "{log:?}"
+        "{case}: {log:?}"
     );
 }
 
@@ -214,16 +219,7 @@ fn exploration_starts_from_headings_off_the_axes() {
         -2.0 * PI / 3.0,
     ] {
         loaded.scenario.uavs[0].start.yaw = yaw;
-        let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
-        let (outcome, reason) = sim.run_to_end();
-        assert_eq!(outcome, Outcome::TimeLimit, "yaw {yaw}: {reason}");
-        let log = sim.world.resource::<DecisionLog>();
-        assert!(
-            log.decisions
-                .iter()
-                .any(|d| d.goal_kind == Some(GoalKind::Frontier)),
-            "yaw {yaw}: {log:?}"
-        );
+        assert_explores_until_the_time_limit(&loaded, &format!("start yaw {yaw}"));
     }
 }
 

@@ -62,6 +62,18 @@ pub fn follow_headings(start: DVec3, start_yaw: f64, waypoints: &[DVec3]) -> Vec
     headings
 }
 
+/// Waypoints at `positions`, each with its heading from `headings`.
+pub fn headed(positions: &[DVec3], headings: impl IntoIterator<Item = f64>) -> Vec<Waypoint> {
+    positions
+        .iter()
+        .zip(headings)
+        .map(|(&position, yaw)| Waypoint {
+            position,
+            yaw: Some(yaw),
+        })
+        .collect()
+}
+
 /// The minimum-snap tour from rest at `start` (heading `start_yaw`) through `positions`, within
 /// the airframe's speed and acceleration limits. Headings are `yaws` (one per waypoint) or
 /// [`follow_headings`]. With `blocked` (a predicate that already inflates obstacles by the
@@ -86,14 +98,7 @@ pub fn plan_tour(
         Some(yaws) => yaws.to_vec(),
         None => follow_headings(start, start_yaw, positions),
     };
-    let waypoints: Vec<Waypoint> = positions
-        .iter()
-        .zip(headings)
-        .map(|(&position, yaw)| Waypoint {
-            position,
-            yaw: Some(yaw),
-        })
-        .collect();
+    let waypoints = headed(positions, headings);
     let from = TrajectoryPoint::at_rest(start, start_yaw);
     let limits = DynamicLimits::of(airframe);
     match blocked {

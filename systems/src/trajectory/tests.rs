@@ -145,16 +145,11 @@ fn a_path_turning_back_keeps_the_yaw_rate_within_its_limit() {
         DVec3::new(0.0, 7.2, 1.8),
         DVec3::new(-1.0, 8.6, 1.25),
     ];
-    let headings =
-        crate::behaviour::waypoints::follow_headings(start.position, start.yaw, &positions);
-    let waypoints: Vec<Waypoint> = positions
-        .iter()
-        .zip(headings)
-        .map(|(&position, yaw)| Waypoint {
-            position,
-            yaw: Some(yaw),
-        })
-        .collect();
+    use crate::behaviour::waypoints::{follow_headings, headed};
+    let waypoints = headed(
+        &positions,
+        follow_headings(start.position, start.yaw, &positions),
+    );
     let limits = DynamicLimits {
         max_yaw_rate: 2.0,
         ..limits()

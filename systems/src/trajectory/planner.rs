@@ -84,7 +84,7 @@ impl DynamicLimits {
 
     /// The largest `max(v / vmax, sqrt(a / amax), yaw rate / max_yaw_rate)` over
     /// `trajectory` when above `floor` ([`worst_ratio`], [`yaw_rate_ratio`]).
-    pub fn worst_ratio(&self, trajectory: &PiecewisePolynomial, floor: f64) -> f64 {
+    fn worst_ratio(&self, trajectory: &PiecewisePolynomial, floor: f64) -> f64 {
         let motion = worst_ratio(trajectory, self.max_velocity, self.max_acceleration, floor);
         motion.max(yaw_rate_ratio(
             trajectory,

@@ -13,9 +13,9 @@
 //! then starts there with a leg out of the blocked voxel (a start), or ends at that cell's
 //! centre (a goal). A traversable point is attached to the nearest open cell it sees (straight
 //! line over traversable voxels); a traversable start that sees none within [`SNAP_RADIUS_M`]
-//! looks as far as [`START_SEE_RADIUS_M`]. Determinism: candidates are ordered by distance, then by
-//! cell index; the queue pops by cost, last in first out among equal costs, and moves are
-//! tried in a fixed order; no hash map is iterated.
+//! looks as far as [`START_SEE_RADIUS_M`]. Determinism: candidates are ordered by distance,
+//! then by cell index; the queue pops by cost, last in first out among equal costs, and moves
+//! are tried in a fixed order; no hash map is iterated.
 
 use super::best_first::Search;
 use super::lattice::Lattice;

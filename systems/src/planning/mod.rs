@@ -7,6 +7,7 @@
 //!   state kept from one search to the next), which can pause at a settled cell and go on.
 //! - [`search`]: A* ([`find_path`]), one Dijkstra to many goals ([`find_paths`], or as far as
 //!   the goals asked for so far need: [`PathSearch`]), and the line-of-sight [`shortcut`].
+//! - `escape`: the way out of a pocket of traversable voxels no open cell is seen from.
 //! - [`braking`]: how a moving start that must turn back stops first ([`Braking`]).
 //! - [`global`]: a feasible, collision-free minimum-snap trajectory along a path
 //!   ([`plan_along`], [`plan_global`]).
@@ -21,6 +22,7 @@
 mod best_first;
 pub mod braking;
 pub mod check;
+mod escape;
 pub mod global;
 pub mod lattice;
 pub mod local;

@@ -13,11 +13,13 @@
 //! then starts there with a leg out of the blocked voxel (a start), or ends at that cell's
 //! centre (a goal). A traversable point is attached to the nearest open cell it sees (straight
 //! line over traversable voxels); a traversable start that sees none within [`SNAP_RADIUS_M`]
-//! looks as far as [`START_SEE_RADIUS_M`]. Determinism: candidates are ordered by distance,
+//! looks as far as [`START_SEE_RADIUS_M`], and one whose cell is an island of the lattice
+//! takes the way out over traversable voxels (`super::escape`). Determinism: candidates are ordered by distance,
 //! then by cell index; the queue pops by cost, last in first out among equal costs, and moves
 //! are tried in a fixed order; no hash map is iterated.
 
 use super::best_first::Search;
+use super::escape::{ESCAPE_RADIUS_M, is_island, way_out};
 use super::lattice::Lattice;
 use super::traversable::TraversableGrid;
 use glam::{DVec3, IVec3};
@@ -71,14 +73,49 @@ pub(super) fn attach(grid: &TraversableGrid, point: DVec3, radius: f64) -> Optio
     }
 }
 
+/// Where a start joins the lattice, and the way to its cell when that is not one leg.
+#[derive(Debug, Clone, PartialEq)]
+pub(super) struct Start {
+    pub(super) end: Endpoint,
+    /// Points between the start and its cell's centre: the way out of a pocket
+    /// ([`super::escape`]); empty for a start attached by [`attach`].
+    pub(super) lead: Vec<DVec3>,
+}
+
 /// Where a start joins the lattice: [`attach`] within [`SNAP_RADIUS_M`], else, for a
-/// traversable start, the nearest open cell it sees within [`START_SEE_RADIUS_M`].
-pub(super) fn attach_start(grid: &TraversableGrid, point: DVec3) -> Option<Endpoint> {
-    attach(grid, point, SNAP_RADIUS_M).or_else(|| {
-        grid.is_traversable_point(point)
-            .then(|| attach(grid, point, START_SEE_RADIUS_M))
-            .flatten()
-    })
+/// traversable start, the nearest open cell it sees within [`START_SEE_RADIUS_M`]. When that
+/// cell is an island ([`is_island`]) or there is none, a traversable start takes the nearest
+/// cell that is not an island and that it reaches over traversable voxels within
+/// [`ESCAPE_RADIUS_M`] ([`way_out`]), else the island, else the nearest open cell it reaches
+/// at all.
+pub(super) fn attach_start(grid: &TraversableGrid, point: DVec3) -> Option<Start> {
+    let traversable = grid.is_traversable_point(point);
+    let attached = attach(grid, point, SNAP_RADIUS_M)
+        .or_else(|| traversable.then(|| attach(grid, point, START_SEE_RADIUS_M))?);
+    let lattice = grid.lattice();
+    let start = |end| Start {
+        end,
+        lead: Vec::new(),
+    };
+    match attached {
+        Some(end) if !is_island(lattice, end.cell) => return Some(start(end)),
+        _ if !traversable => return attached.map(start),
+        _ => {}
+    }
+    let escape = |accept: &dyn Fn(usize) -> bool| {
+        let (lead, cell) = way_out(grid, point, ESCAPE_RADIUS_M, accept)?;
+        Some(Start {
+            end: Endpoint {
+                point,
+                cell,
+                traversable,
+            },
+            lead,
+        })
+    };
+    escape(&|cell| !is_island(lattice, cell))
+        .or_else(|| attached.map(start))
+        .or_else(|| escape(&|_| true))
 }
 
 /// Where a query point lies on the lattice.
@@ -248,10 +285,13 @@ fn push_point(path: &mut Vec<DVec3>, p: DVec3) {
     }
 }
 
-fn assemble(grid: &TraversableGrid, from: &Endpoint, cells: &[usize], to: &Endpoint) -> Vec<DVec3> {
+fn assemble(grid: &TraversableGrid, from: &Start, cells: &[usize], to: &Endpoint) -> Vec<DVec3> {
     let lattice = grid.lattice();
-    let mut path = Vec::with_capacity(cells.len() + 2);
-    path.push(from.point);
+    let mut path = Vec::with_capacity(from.lead.len() + cells.len() + 2);
+    path.push(from.end.point);
+    for &p in &from.lead {
+        push_point(&mut path, p);
+    }
     for &cell in cells {
         push_point(
             &mut path,
@@ -277,8 +317,12 @@ pub fn find_path(
     let start = attach_start(grid, from)?;
     let goal = attach(grid, to, GOAL_SNAP_RADIUS_M)?;
     let lattice = grid.lattice();
-    let mut search =
-        Search::<true>::new(lattice, start.cell, lattice.cell(goal.cell), max_expansions);
+    let mut search = Search::<true>::new(
+        lattice,
+        start.end.cell,
+        lattice.cell(goal.cell),
+        max_expansions,
+    );
     search.run(lattice, |cell| cell == goal.cell);
     let cells = search
         .nodes()
@@ -308,7 +352,7 @@ pub fn find_paths(
 /// among the first ones searches a small part of the map instead of all of it.
 pub struct PathSearch<'g> {
     grid: &'g TraversableGrid,
-    start: Option<Endpoint>,
+    start: Option<Start>,
     goals: Vec<DVec3>,
     /// Where each goal joins the lattice, found when it is first asked for (attaching every
     /// goal of a decision up front cost 1 % of a mission).
@@ -351,7 +395,7 @@ impl<'g> PathSearch<'g> {
     /// The paths to the goals `which` (indices into the goals given), in that order: the
     /// search goes on until each of their cells is settled, or no more can be.
     pub fn paths(&mut self, which: &[usize]) -> Vec<Option<Vec<DVec3>>> {
-        let Some(start) = self.start else {
+        let Some(start) = &self.start else {
             return vec![None; which.len()];
         };
         let lattice = self.grid.lattice();
@@ -376,7 +420,7 @@ impl<'g> PathSearch<'g> {
         }
         if self.remaining > 0 {
             let search = self.search.get_or_insert_with(|| {
-                Search::new(lattice, start.cell, IVec3::ZERO, self.max_expansions)
+                Search::new(lattice, start.end.cell, IVec3::ZERO, self.max_expansions)
             });
             let (pending, remaining) = (&mut self.pending, &mut self.remaining);
             search.run(lattice, |cell| {
@@ -397,7 +441,7 @@ impl<'g> PathSearch<'g> {
                     .nodes()
                     .is_closed(end.cell)
                     .then(|| search.trace(lattice.moves(), end.cell))?;
-                Some(assemble(self.grid, &start, &cells, &end))
+                Some(assemble(self.grid, start, &cells, &end))
             })
             .collect()
     }

@@ -425,3 +425,36 @@ fn a_start_in_a_narrow_pocket_sees_its_way_to_the_lattice() {
     let paths = find_paths(&grid, start, &[goal], usize::MAX);
     assert_eq!(paths[0].as_ref(), Some(&path));
 }
+
+/// A start whose open cells form an island (a pocket of 4 x 4 x 4 free voxels whose only way
+/// out is a lane one voxel wide that turns a corner) reaches the room the lane leads to: over
+/// traversable voxels to the nearest open cell that is not an island, every leg in line of
+/// sight. Before, it attached to its pocket's cells, and no path left them.
+#[test]
+fn a_start_on_an_island_of_the_lattice_takes_the_way_out_over_voxels() {
+    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 1.6));
+    map.fill_all(OCCUPIED);
+    // The room x < 2.0 m; the pocket x, y 3.0-3.4 m, z 0.8-1.2 m; the lane from the pocket
+    // along -x to x = 2.5 m, along -y to y = 2.7 m, then along -x into the room.
+    map.fill(IVec3::new(0, 0, 0), IVec3::new(19, 63, 15), FREE);
+    map.fill(IVec3::new(30, 30, 8), IVec3::new(33, 33, 11), FREE);
+    map.fill(IVec3::new(25, 31, 9), IVec3::new(29, 31, 9), FREE);
+    map.fill(IVec3::new(25, 27, 9), IVec3::new(25, 30, 9), FREE);
+    map.fill(IVec3::new(20, 27, 9), IVec3::new(24, 27, 9), FREE);
+    let grid = map.grid(0.0);
+    let start = DVec3::new(3.15, 3.15, 0.95);
+    let goal = DVec3::new(1.0, 3.0, 0.8);
+    let lattice = grid.lattice();
+    let pocket = lattice.index(IVec3::new(15, 15, 4)).unwrap();
+    assert!(lattice.is_open(pocket) && super::escape::is_island(lattice, pocket));
+    let room = lattice.index(IVec3::new(5, 15, 4)).unwrap();
+    assert!(!super::escape::is_island(lattice, room));
+
+    let path = find_path(&grid, start, goal, usize::MAX).expect("the way out of the pocket");
+    assert_eq!((path[0], *path.last().unwrap()), (start, goal));
+    assert!(path.windows(2).all(|w| grid.line_of_sight(w[0], w[1])));
+    // The way passes the lane's corner at (2.55, 3.15, 0.95) and the one at (2.55, 2.75).
+    assert!(path.iter().any(|p| p.x < 2.6 && p.y > 3.1), "{path:?}");
+    let paths = find_paths(&grid, start, &[goal], usize::MAX);
+    assert_eq!(paths[0].as_ref(), Some(&path));
+}

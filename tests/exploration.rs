@@ -1,7 +1,8 @@
 //! Exploration end to end (issue 4 "Must show"): every strategy explores the EAAE scenes to at
 //! least 95 % of the reachable volume without crashing, on two seeds; a seed fixes the decision
-//! log; a closed room is never entered and the run still ends `complete`; a battery-limited
-//! run flies home; a strategy is added as one system without touching the others.
+//! log; a closed room is never entered and the run still ends `complete`; a forest of round
+//! trunks is explored to the end; a battery-limited run flies home; a strategy is added as one
+//! system without touching the others.
 
 mod common;
 
@@ -163,6 +164,33 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
     let mut reader = SystemState::<MapReader>::new(world);
     let explored = volume.explored_pct(&reader.get(world).unwrap());
     assert!(explored >= 95.0, "{explored}");
+}
+
+/// Round trunks leave frontier voxels around their insides that no flight clears; before they
+/// were ignored at a reached goal ([`uavex::systems::exploration::interior`]), this forest's
+/// mission flew between them until its time limit (400 s, 99.997 % of the reachable volume
+/// explored), as 20 of 24 missions in a larger study did until their batteries were empty.
+#[test]
+fn a_forest_of_round_trunks_is_explored_to_the_end() {
+    let path = format!(
+        "{}/tests/fixtures/forest_of_trunks.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let summary = run_seed(&loaded, 2);
+    let reachable = summary
+        .exploration
+        .as_ref()
+        .and_then(|keys| keys.explored_reachable_pct)
+        .expect("an exploration run floods its reachable volume");
+    assert_eq!(
+        summary.outcome,
+        Outcome::Complete,
+        "{} ({reachable:.3} % explored)",
+        summary.reason
+    );
+    assert!(summary.mission_time_s < loaded.scenario.time_limit_s);
+    assert!(reachable >= 99.0, "{reachable}");
 }
 
 /// A start nearer a face of the map than the planner's radius (here 0.20 m below the top of a

@@ -11,9 +11,11 @@
 //!
 //! Frontier that a reached goal could not clear (a sliver no viewpoint sees) would attract the
 //! UAV forever: a voxel still frontier after a second reached goal covering it is ignored from
-//! then on ([`VisitedFrontier`]).
+//! then on ([`VisitedFrontier`]); so is at once, when a goal is reached, a frontier voxel that
+//! is one only because it borders the inside of an obstacle ([`super::interior`]).
 
 use super::commit::{DecisionBackoff, energy_drawn};
+use super::interior::around_interiors;
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
 use crate::mapping::MapReader;
 use crate::planning::{
@@ -198,10 +200,13 @@ pub fn fly_to_goals(
                         .copied()
                         .filter(|&k| frontier.contains(k))
                         .collect();
-                    for key in left {
+                    for &key in &left {
                         if !visited.0.insert(key) {
                             frontier.ignore(key);
                         }
+                    }
+                    for key in around_interiors(&map, &left) {
+                        frontier.ignore(key);
                     }
                     entity.insert(NeedsDecision);
                 }

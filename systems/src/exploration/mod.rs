@@ -19,6 +19,7 @@ pub mod budget;
 pub mod commit;
 pub mod evaluate;
 pub mod execute;
+pub mod interior;
 pub mod open_tour;
 pub mod propose;
 pub mod strategy;

@@ -25,4 +25,4 @@ pub use filter::{is_clear, occupied_near_centroid, sample_viewpoints};
 pub use system::{insert_frontier_resources, refresh_clusters, update_frontiers};
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

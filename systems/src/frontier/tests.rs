@@ -18,7 +18,7 @@ mod system_tests;
 
 /// Keys -32..=29 on each axis at 0.1 m (chunks -2..=1): the -faces of the map are chunk faces,
 /// the +faces lie inside chunk 1 (keys 16..=31), so both kinds of map edge are exercised.
-pub(super) fn config() -> MapConfig {
+pub(crate) fn config() -> MapConfig {
     MapConfig::new(&MapSettings {
         bounds_min: DVec3::splat(-3.2),
         bounds_max: DVec3::splat(2.95),
@@ -28,7 +28,7 @@ pub(super) fn config() -> MapConfig {
 }
 
 /// Writes a voxel's state directly (a hand-made grid); returns its chunk.
-pub(super) fn set(store: &mut ChunkStore, key: IVec3, state: VoxelState) -> ChunkCoord {
+pub(crate) fn set(store: &mut ChunkStore, key: IVec3, state: VoxelState) -> ChunkCoord {
     let coord = ChunkCoord::of_key(key);
     let (flat, local) = store.config().address_of(key).expect("key in map");
     let (chunk, _) = store.chunk_mut(flat, coord);

@@ -24,14 +24,20 @@
 use crate::frontier::detect::NEIGHBOURS;
 use crate::mapping::OccupancyMap;
 use glam::IVec3;
-use std::collections::{HashSet, VecDeque};
+use std::collections::VecDeque;
 use uavex_components::map::VoxelState;
+
+/// Sets of voxels, asked for membership only (never iterated in an order that matters).
+type VoxelSet = std::collections::HashSet<IVec3, foldhash::fast::RandomState>;
 
 /// Largest unknown region (voxels) taken for the inside of an obstacle: a round trunk of 0.7 m
 /// radius over 3 m at 0.1 m.
 pub const INTERIOR_MAX_VOXELS: usize = 5_000;
 /// Least share of an inside's faces toward known voxels that are occupied.
 pub const INTERIOR_MIN_OCCUPIED_SHARE: f64 = 0.4;
+/// Most unknown voxels one reached goal floods, all regions together (the floods run in the
+/// Plan stage; a region too large to be an inside costs [`INTERIOR_MAX_VOXELS`]).
+pub const INTERIOR_FLOOD_BUDGET: usize = 4 * INTERIOR_MAX_VOXELS;
 
 /// The face-connected region of unknown voxels holding `seed`, as far as it was flooded.
 #[derive(Debug, Clone, PartialEq)]
@@ -50,10 +56,11 @@ pub struct UnknownRegion {
 /// occupied. Faces toward outside the map count for neither side.
 pub fn unknown_region(map: &impl OccupancyMap, seed: IVec3) -> UnknownRegion {
     let config = map.config();
-    let mut seen = HashSet::from([seed]);
+    let mut seen = VoxelSet::default();
+    seen.insert(seed);
     let mut voxels = vec![seed];
     let mut queue = VecDeque::from([seed]);
-    let mut free_boundary = HashSet::new();
+    let mut free_boundary = VoxelSet::default();
     let (mut occupied_faces, mut free_faces) = (0usize, 0usize);
     let mut enclosed = true;
     'flood: while let Some(voxel) = queue.pop_front() {
@@ -96,19 +103,33 @@ pub fn unknown_region(map: &impl OccupancyMap, seed: IVec3) -> UnknownRegion {
 
 /// The free voxels that border the insides of obstacles found behind the frontier voxels
 /// `left` (those a reached goal did not clear) and border nothing else unknown: frontier
-/// voxels only because of those insides, for the caller to ignore. Sorted; each unknown
-/// region is flooded once.
+/// voxels only because of those insides, for the caller to ignore. Sorted.
+///
+/// Each unknown region is flooded once, and only from an unknown voxel with an occupied face
+/// neighbour (an inside is bounded mostly by occupied voxels; the frontier at the edge of the
+/// explored space, beside no surface, starts no flood), until [`INTERIOR_FLOOD_BUDGET`]
+/// voxels have been flooded.
 pub fn around_interiors(map: &impl OccupancyMap, left: &[IVec3]) -> Vec<IVec3> {
     let config = map.config();
-    let mut flooded: HashSet<IVec3> = HashSet::new();
-    let mut interiors: HashSet<IVec3> = HashSet::new();
+    let beside_a_surface = |voxel: IVec3| {
+        NEIGHBOURS.iter().any(|&d| {
+            let n = voxel + d;
+            config.contains_key(n) && map.state(n) == VoxelState::Occupied
+        })
+    };
+    let mut flooded = VoxelSet::default();
+    let mut interiors = VoxelSet::default();
     let mut around = Vec::new();
     for &key in left {
         for d in NEIGHBOURS {
             let seed = key + d;
+            if flooded.len() >= INTERIOR_FLOOD_BUDGET {
+                break;
+            }
             if !config.contains_key(seed)
                 || flooded.contains(&seed)
                 || map.state(seed) != VoxelState::Unknown
+                || !beside_a_surface(seed)
             {
                 continue;
             }

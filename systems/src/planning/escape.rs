@@ -35,7 +35,9 @@ pub const ISLAND_CELLS: usize = 256;
 /// Whether the open cells reachable by allowed moves from the open cell `cell` (itself
 /// included) are fewer than [`ISLAND_CELLS`].
 pub(super) fn is_island(lattice: &Lattice, cell: usize) -> bool {
-    let mut seen = HashSet::from([cell]);
+    let mut seen: HashSet<usize, foldhash::fast::RandomState> =
+        HashSet::with_capacity_and_hasher(2 * ISLAND_CELLS, Default::default());
+    seen.insert(cell);
     let mut stack = vec![cell];
     while let Some(at) = stack.pop() {
         let allowed = lattice.allowed_moves(at);

@@ -169,7 +169,7 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
 /// Round trunks leave frontier voxels around their insides that no flight clears; before they
 /// were ignored at a reached goal ([`uavex::systems::exploration::interior`]), this forest's
 /// mission flew between them until its time limit (400 s, 99.997 % of the reachable volume
-/// explored), as 20 of 24 missions in a larger study did until their batteries were empty.
+/// explored), as 13 of 24 missions in a larger study did until their batteries were empty.
 #[test]
 fn a_forest_of_round_trunks_is_explored_to_the_end() {
     let path = format!(

@@ -6,9 +6,10 @@
 //! wholly inside the trunk, is never entered (every ray toward it ends at the surface first).
 //! Passes along a trunk make more of them (grazing rays clear the voxels the surface only
 //! touches, and the next layer in becomes the unknown neighbour) faster than the rule of two
-//! reached goals (`super::execute`) retires them. In a 16 x 16 m forest of round trunks, 20 of
+//! reached goals (`super::execute`) retires them. In a 16 x 16 m forest of round trunks, 13 of
 //! 24 missions flew from one such sliver to the next until their batteries were empty, with
-//! 99.99 % of the reachable volume explored some 350 s earlier.
+//! 99.98-100 % of the reachable volume explored (one had explored 98.1 % of its box by 250 s,
+//! and gained 0.14 % in the 350 s after).
 //!
 //! What gives the inside of an obstacle away, in the map alone: the unknown voxels behind such
 //! a frontier voxel form a small region that the map encloses (every face neighbour known, or

@@ -20,6 +20,7 @@
 use super::lattice::Lattice;
 use super::search::shortcut_indices;
 use super::traversable::TraversableGrid;
+use crate::frontier::detect::NEIGHBOURS;
 use glam::{DVec3, IVec3};
 use std::collections::{HashSet, VecDeque};
 
@@ -54,20 +55,10 @@ pub(super) fn is_island(lattice: &Lattice, cell: usize) -> bool {
     true
 }
 
-/// Face neighbours, in the fixed order the search tries them (determinism).
-const FACES: [IVec3; 6] = [
-    IVec3::NEG_X,
-    IVec3::X,
-    IVec3::NEG_Y,
-    IVec3::Y,
-    IVec3::NEG_Z,
-    IVec3::Z,
-];
-
 /// The way from the traversable point `start` to the nearest open cell that `accept` takes,
 /// reachable over traversable voxels within `radius_m` (fewest face steps; ties to the earlier
-/// neighbour in [`FACES`] order; `accept` is asked once per cell): the points strictly between
-/// `start` and the cell's centre, and the cell's index. `None` when `start` is not
+/// neighbour in [`NEIGHBOURS`] order; `accept` is asked once per cell): the points strictly
+/// between `start` and the cell's centre, and the cell's index. `None` when `start` is not
 /// traversable, the grid has no lattice, or no such cell is reachable within the radius.
 pub(super) fn way_out(
     grid: &TraversableGrid,
@@ -125,7 +116,7 @@ pub(super) fn way_out(
             refused.insert(index);
         }
         let here = slot(key).expect("visited keys lie in the box") as u32;
-        for face in FACES {
+        for face in NEIGHBOURS {
             let next = key + face;
             let Some(s) = slot(next) else { continue };
             if parent[s] == UNSEEN && grid.is_traversable(next) {

@@ -14,9 +14,9 @@
 //! centre (a goal). A traversable point is attached to the nearest open cell it sees (straight
 //! line over traversable voxels); a traversable start that sees none within [`SNAP_RADIUS_M`]
 //! looks as far as [`START_SEE_RADIUS_M`], and one whose cell is an island of the lattice
-//! takes the way out over traversable voxels (`super::escape`). Determinism: candidates are ordered by distance,
-//! then by cell index; the queue pops by cost, last in first out among equal costs, and moves
-//! are tried in a fixed order; no hash map is iterated.
+//! takes the way out over traversable voxels (`super::escape`). Determinism: candidates are
+//! ordered by distance, then by cell index; the queue pops by cost, last in first out among
+//! equal costs, and moves are tried in a fixed order; no hash map is iterated.
 
 use super::best_first::Search;
 use super::escape::{ESCAPE_RADIUS_M, is_island, way_out};

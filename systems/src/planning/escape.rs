@@ -73,7 +73,8 @@ pub(super) fn way_out(
     let resolution = grid.resolution();
     let n = (radius_m / resolution).ceil().max(1.0) as i32;
     let side = 2 * n + 1;
-    let origin = grid.key_of(start) - IVec3::splat(n);
+    let first = grid.key_of(start);
+    let origin = first - IVec3::splat(n);
     let slot = |key: IVec3| {
         let d = key - origin;
         (d.cmpge(IVec3::ZERO).all() && d.cmplt(IVec3::splat(side)).all())
@@ -81,7 +82,6 @@ pub(super) fn way_out(
     };
     const UNSEEN: u32 = u32::MAX;
     let mut parent = vec![UNSEEN; (side * side * side) as usize];
-    let first = grid.key_of(start);
     let first_slot = slot(first).expect("the start is the box's centre");
     parent[first_slot] = first_slot as u32;
     let mut queue = VecDeque::from([first]);
@@ -89,7 +89,7 @@ pub(super) fn way_out(
         let s = s as i32;
         origin + IVec3::new(s % side, (s / side) % side, s / (side * side))
     };
-    let mut refused = HashSet::new();
+    let mut refused: HashSet<usize, foldhash::fast::RandomState> = HashSet::default();
     while let Some(key) = queue.pop_front() {
         let cell = Lattice::cell_of_key(key);
         let open = lattice
@@ -97,16 +97,16 @@ pub(super) fn way_out(
             .filter(|&i| lattice.is_open(i) && !refused.contains(&i));
         if let Some(index) = open {
             if accept(index) {
-                let mut keys = vec![key];
+                // The voxels back to the start, then start -> voxel centres -> cell centre.
                 let mut at = slot(key).expect("visited keys lie in the box");
+                let mut keys = vec![key];
                 while parent[at] as usize != at {
                     at = parent[at] as usize;
                     keys.push(key_of_slot(at));
                 }
-                keys.reverse();
                 let centre = |k: IVec3| (k.as_dvec3() + 0.5) * resolution;
                 let points: Vec<DVec3> = std::iter::once(start)
-                    .chain(keys.into_iter().map(centre))
+                    .chain(keys.into_iter().rev().map(centre))
                     .chain(std::iter::once(lattice.centre(cell, resolution)))
                     .collect();
                 let kept = shortcut_indices(&points, |a, b| grid.line_of_sight(a, b));

@@ -27,7 +27,7 @@ use uavex_systems::trajectory::{
 fn pillars() -> Vec<(Pose, SharedShape)> {
     let loaded = scenario::load("scenarios/eaae_pillars.toml").expect("the shipped scene loads");
     let spec = &loaded.scenario;
-    let world = build_world(&spec.world, RunSeed(spec.seed), &[], &loaded.base_dir)
+    let world = build_world(&spec.world, RunSeed(spec.seed), &[], &[], &loaded.base_dir)
         .expect("the shipped scene builds");
     world
         .obstacles()

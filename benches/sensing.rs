@@ -51,7 +51,7 @@ fn pillars() -> (WorldGeometry, MapConfig) {
     let loaded = scenario::load(path).expect("the shipped Pillars scenario loads");
     let world_spec = &loaded.scenario.world;
     let start = Vec3::new(0.0, 0.0, 1.0);
-    let world = build_world(world_spec, RunSeed(1), &[start], &loaded.base_dir)
+    let world = build_world(world_spec, RunSeed(1), &[start], &[], &loaded.base_dir)
         .expect("the Pillars world builds");
     let map = MapConfig::new(&MapSettings {
         resolution: loaded.scenario.map.resolution,

@@ -12,15 +12,19 @@ use std::collections::BTreeSet;
 use uavex::components::exploration::{CandidateScope, Chosen, DecisionLog, GoalKind, GoalOutcome};
 use uavex::components::map::MapConfig;
 use uavex::components::sim::Outcome;
+use uavex::components::sim::RunSeed;
 use uavex::components::world::WorldGeometry;
+use uavex::engine::exploration::setup::StartCapsule;
 use uavex::engine::exploration::{
     BudgetSpec, CandidateCount, Evaluate, ExploreSpec, StrategyName, decisions_csv,
 };
+use uavex::engine::flight::airframe_of;
 use uavex::engine::output::RunSummary;
 use uavex::engine::reachable::ReachableVolume;
 use uavex::engine::run::{RunOptions, run};
 use uavex::engine::scenario::{BehaviourSpec, LoadedScenario, load};
 use uavex::engine::sim::Sim;
+use uavex::engine::world::build_world;
 use uavex::systems::exploration::DecideStep;
 use uavex::systems::exploration::strategy::{
     CandidateQuery, ClassicStrategy, Deciding, choosable, first_min_by,
@@ -191,6 +195,52 @@ fn a_forest_of_round_trunks_is_explored_to_the_end() {
     );
     assert!(summary.mission_time_s < loaded.scenario.time_limit_s);
     assert!(reachable >= 99.0, "{reachable}");
+}
+
+/// A seeded forest keeps the explorer's start capsule clear by itself. Seeds that drew a trunk
+/// into it (6, 7 and 11 of this forest's first 12) used to be refused when the run was built, so a sweep over
+/// seeds lost them; now every seed builds, without the trunks the field drew there.
+#[test]
+fn every_seed_of_a_forest_leaves_the_explorers_start_capsule_clear() {
+    let path = format!(
+        "{}/tests/fixtures/forest_of_trunks.toml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let scenario = &loaded.scenario;
+    let spec = &scenario.uavs[0];
+    let airframe = airframe_of(spec, 0).unwrap();
+    let resolution = scenario.map.resolution;
+    let capsule = StartCapsule::of_explorer(spec, &airframe, resolution).unwrap();
+    let blocked = |world: &WorldGeometry| {
+        capsule
+            .centres(resolution)
+            .any(|c| world.intersects_ball(c.as_vec3(), capsule.radius as f32))
+    };
+    let start = glam::DVec3::from_array(spec.start.position).as_vec3();
+    let mut drawn_into_it = Vec::new();
+    for seed in 1..=12 {
+        // The same field without the capsule kept clear: what the run would have refused.
+        let bare = build_world(
+            &scenario.world,
+            RunSeed(seed),
+            &[start],
+            &[],
+            &loaded.base_dir,
+        )
+        .unwrap_or_else(|e| panic!("{e:?}"));
+        if blocked(&bare) {
+            drawn_into_it.push(seed);
+        }
+        let sim = Sim::build(&loaded, seed).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
+        let world = sim.world.resource::<WorldGeometry>();
+        assert!(!blocked(world), "seed {seed}");
+        // Only the trunks in the capsule were removed: none where it was clear already.
+        let removed = bare.obstacles().len() - world.obstacles().len();
+        assert_eq!(removed > 0, blocked(&bare), "seed {seed}");
+        assert!(removed <= 2, "seed {seed}: {removed}");
+    }
+    assert_eq!(drawn_into_it, [6, 7, 11]);
 }
 
 /// A start nearer a face of the map than the planner's radius (here 0.20 m below the top of a

@@ -476,7 +476,8 @@ mod tests {
         let loaded = load(dir.join(file)).unwrap();
         let scenario = &loaded.scenario;
         let start = Vec3::from_array(scenario.uavs[0].start.position.map(|c| c as f32));
-        let world = build_world(&scenario.world, RunSeed(1), &[start], &loaded.base_dir).unwrap();
+        let world =
+            build_world(&scenario.world, RunSeed(1), &[start], &[], &loaded.base_dir).unwrap();
         let config = MapConfig::new(&MapSettings {
             resolution: scenario.map.resolution,
             bounds_min: DVec3::from_array(scenario.world.bounds.min),

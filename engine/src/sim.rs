@@ -1,7 +1,7 @@
 //! The simulation of one run: a bevy `World` built from one scenario and one seed, and the
 //! `Tick` schedule with the pipeline stages (DESIGN.md "One tick").
 
-use crate::exploration::setup::camera_of;
+use crate::exploration::setup::{StartCapsule, camera_of};
 use crate::exploration::{Evaluate, add_exploration, explorer_components};
 use crate::flight::{Physics, airframe_of, end_on_empty_battery, step_physics, waypoint_flight};
 use crate::metrics::{RunRecord, record_metrics};
@@ -68,8 +68,32 @@ impl Sim {
             .iter()
             .map(|u| vec3(u.start.position))
             .collect();
-        let geometry =
-            build_world(&scenario.world, run_seed, &starts, &loaded.base_dir).map_err(locate)?;
+        let map = MapConfig::new(&MapSettings {
+            resolution: scenario.map.resolution,
+            bounds_min: DVec3::from_array(scenario.world.bounds.min),
+            bounds_max: DVec3::from_array(scenario.world.bounds.max),
+            p_min: scenario.map.p_min,
+            p_max: scenario.map.p_max,
+        })
+        .map_err(|e| loaded.errors([("map", e.to_string())]))?;
+        // What explorers need clear ahead of their starts, which seeded fields leave free.
+        let kept_clear: Vec<_> = scenario
+            .uavs
+            .iter()
+            .zip(&airframes)
+            .filter_map(|(spec, airframe)| {
+                StartCapsule::of_explorer(spec, airframe, map.resolution())
+            })
+            .map(|capsule| capsule.shape())
+            .collect();
+        let geometry = build_world(
+            &scenario.world,
+            run_seed,
+            &starts,
+            &kept_clear,
+            &loaded.base_dir,
+        )
+        .map_err(locate)?;
         // Each UAV must fit, with its bounding sphere, where it starts.
         let radii: Vec<f32> = airframes
             .iter()
@@ -94,14 +118,6 @@ impl Sim {
         } else {
             None
         };
-        let map = MapConfig::new(&MapSettings {
-            resolution: scenario.map.resolution,
-            bounds_min: DVec3::from_array(scenario.world.bounds.min),
-            bounds_max: DVec3::from_array(scenario.world.bounds.max),
-            p_min: scenario.map.p_min,
-            p_max: scenario.map.p_max,
-        })
-        .map_err(|e| loaded.errors([("map", e.to_string())]))?;
 
         let mut world = World::new();
         world.insert_resource(SimClock::new(scenario.physics_rate_hz));

@@ -76,6 +76,7 @@ fn every_shipped_scenario_loads_and_builds_its_world() {
             &loaded.scenario.world,
             RunSeed(loaded.scenario.seed),
             &starts,
+            &[],
             &loaded.base_dir,
         )
         .unwrap_or_else(|errors| panic!("{}: {errors:?}", file.display()));

@@ -4,10 +4,11 @@
 
 use super::spec::{ExploreSpec, StrategyName};
 use crate::flight::{Physics, dynamic_flight};
-use crate::scenario::{SensorSpec, UavSpec};
+use crate::scenario::{BehaviourSpec, SensorSpec, UavSpec};
 use crate::world::BuildError;
 use bevy_ecs::prelude::*;
 use glam::{DVec3, IVec3};
+use parry3d::shape::Capsule;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{
@@ -91,6 +92,31 @@ impl StartCapsule {
         }
     }
 
+    /// The capsule of an exploring UAV `spec` (flying `airframe`, mapping at `resolution`),
+    /// or `None` if it does not explore or has no depth camera (its run is refused then).
+    pub fn of_explorer(spec: &UavSpec, airframe: &Airframe, resolution: f64) -> Option<Self> {
+        if !matches!(spec.behaviour, BehaviourSpec::Explore(_)) {
+            return None;
+        }
+        first_camera(spec).map(|camera| Self::ahead_of(spec, &camera, airframe, resolution))
+    }
+
+    /// The capsule ahead of `spec`'s start for its `camera`.
+    fn ahead_of(spec: &UavSpec, camera: &CameraView, airframe: &Airframe, resolution: f64) -> Self {
+        Self::new(
+            DVec3::from_array(spec.start.position),
+            spec.start.yaw,
+            camera.vfov,
+            inflation_of(airframe),
+            resolution,
+        )
+    }
+
+    /// The capsule as parry's shape (the space a seeded world keeps clear, `world::build_world`).
+    pub fn shape(&self) -> Capsule {
+        Capsule::new(self.from.as_vec3(), self.to.as_vec3(), self.radius as f32)
+    }
+
     /// Ball centres along the capsule, a voxel apart.
     pub fn centres(&self, resolution: f64) -> impl Iterator<Item = DVec3> + '_ {
         let n = (self.from.distance(self.to) / resolution).ceil().max(1.0) as usize;
@@ -125,13 +151,9 @@ pub fn explorer_components(
     })?;
     let range = camera.range_max;
     let start = DVec3::from_array(spec.start.position);
-    let capsule = StartCapsule::new(
-        start,
-        spec.start.yaw,
-        camera.vfov,
-        inflation_of(airframe),
-        resolution,
-    );
+    let capsule = StartCapsule::ahead_of(spec, &camera, airframe, resolution);
+    // Seeded pillar fields keep the capsule clear by themselves; any other obstacle in it is
+    // the scenario's to move.
     if capsule
         .centres(resolution)
         .any(|c| geometry.intersects_ball(c.as_vec3(), capsule.radius as f32))

@@ -69,6 +69,7 @@ pub(super) fn pillars_world() -> (WorldSpec, WorldGeometry) {
         &spec,
         RunSeed(0),
         &[Vec3::new(0.0, 0.0, 1.0)],
+        &[],
         Path::new("."),
     )
     .unwrap();

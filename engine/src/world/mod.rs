@@ -13,12 +13,13 @@ mod primitives;
 mod sensors;
 
 pub use colliders::colliders;
-pub use pillars::{Pillar, PillarField, generate_pillars};
+pub use pillars::{KEPT_CLEAR_MARGIN_M, Pillar, PillarField, generate_pillars};
 pub use primitives::{GROUND_MARGIN, GROUND_THICKNESS};
 pub use sensors::{SensorBundle, mount_from_spec, sensor_bundle};
 
 use crate::scenario::{ObstacleSpec, WorldSpec};
 use glam::Vec3;
+use parry3d::shape::Capsule;
 use std::path::Path;
 use uavex_components::sim::RunSeed;
 use uavex_components::world::{Obstacle, WorldGeometry, WorldGeometryError};
@@ -43,12 +44,14 @@ impl BuildError {
 }
 
 /// Builds the world geometry of `spec`: every obstacle (boxes, cylinders, spheres, meshes and
-/// clouds from files relative to `base_dir`, seeded pillar fields kept clear of `starts`) plus
-/// the ground. Collects every problem before giving up.
+/// clouds from files relative to `base_dir`, seeded pillar fields kept clear of `starts` and of
+/// the capsules `kept_clear`, e.g. explorers' start capsules) plus the ground. Collects every
+/// problem before giving up.
 pub fn build_world(
     spec: &WorldSpec,
     seed: RunSeed,
     starts: &[Vec3],
+    kept_clear: &[Capsule],
     base_dir: &Path,
 ) -> Result<WorldGeometry, Vec<BuildError>> {
     let mut obstacles = Vec::new();
@@ -65,7 +68,9 @@ pub fn build_world(
             ObstacleSpec::Mesh { .. } | ObstacleSpec::Cloud { .. } => {
                 files::build(obstacle, index, &field, base_dir).map(|o| vec![o])
             }
-            ObstacleSpec::Pillars { .. } => pillars::build(obstacle, index, &field, seed, starts),
+            ObstacleSpec::Pillars { .. } => {
+                pillars::build(obstacle, index, &field, seed, starts, kept_clear)
+            }
             _ => primitives::build(obstacle, index, &field).map(|o| vec![o]),
         };
         match built {

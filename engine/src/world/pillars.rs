@@ -6,16 +6,22 @@
 //! [radius_min, radius_max]. This is the usual model of a random forest, and it makes `density`
 //! the true expected number per square metre whatever the area. Pillars may overlap (their union
 //! is the obstacle). Pillars closer than `start_clearance` to a UAV start are then removed, which
-//! leaves the process unchanged outside those discs.
+//! leaves the process unchanged outside those discs, and so are pillars that touch a space a UAV
+//! needs clear at its start whatever the field asks (an explorer's start capsule,
+//! `exploration::setup::StartCapsule`): without that, every seed that drew a trunk into it would
+//! be refused when the run is built, and a sweep over seeds would lose those runs.
 //!
 //! Randomness: `RunSeed::stream(stream::WORLD_GENERATOR, i)` for the generator at
 //! `world.obstacle[i]`; the count is drawn first, then per pillar x, y and radius, so one
 //! generator's pillars depend on the seed and its own parameters only.
 
-use super::primitives::upright_cylinder;
+use super::primitives::{upright_cylinder, upright_pose};
 use super::{BuildError, display_name, require_finite, require_positive};
 use crate::scenario::ObstacleSpec;
 use glam::{DVec2, Vec2, Vec3};
+use parry3d::math::Pose;
+use parry3d::query::intersection_test;
+use parry3d::shape::{Capsule, Cylinder};
 use rand::Rng;
 use rand_distr::{Distribution, Poisson};
 use uavex_components::sim::{RunSeed, stream};
@@ -44,10 +50,22 @@ pub struct Pillar {
     pub radius: f32,
 }
 
+/// How much a space kept clear ([`generate_pillars`]'s `kept_clear`) is grown before pillars are
+/// tested against it: the run's own check of that space (balls along the capsule against the
+/// exact cylinder) then passes whatever the rounding of the two tests.
+pub const KEPT_CLEAR_MARGIN_M: f32 = 1e-3;
+
 /// Draws the pillars of `field` from `rng`, without those closer than `start_clearance` to a
-/// start (distance from the start to the pillar's solid, in 3D).
-/// A region or radius range that is empty (or NaN) gives no pillars.
-pub fn generate_pillars(field: &PillarField, starts: &[Vec3], rng: &mut impl Rng) -> Vec<Pillar> {
+/// start (distance from the start to the pillar's solid, in 3D) and those that touch a capsule
+/// of `kept_clear` (grown by [`KEPT_CLEAR_MARGIN_M`]).
+/// A region or radius range that is empty (or NaN) gives no pillars. The draws do not depend on
+/// what is removed: a pillar kept is the same whatever the starts and capsules.
+pub fn generate_pillars(
+    field: &PillarField,
+    starts: &[Vec3],
+    kept_clear: &[Capsule],
+    rng: &mut impl Rng,
+) -> Vec<Pillar> {
     let drawable = field.region_min.x < field.region_max.x
         && field.region_min.y < field.region_max.y
         && field.radius_min <= field.radius_max;
@@ -65,14 +83,29 @@ pub fn generate_pillars(field: &PillarField, starts: &[Vec3], rng: &mut impl Rng
         );
         let radius = rng.random_range(field.radius_min..=field.radius_max);
         let pillar = Pillar { base, radius };
-        if starts
+        let clear_of_starts = starts
             .iter()
-            .all(|s| distance_to_pillar(*s, &pillar, field.height) >= field.start_clearance)
-        {
+            .all(|s| distance_to_pillar(*s, &pillar, field.height) >= field.start_clearance);
+        if clear_of_starts && !kept_clear.iter().any(|c| touches(&pillar, field.height, c)) {
             pillars.push(pillar);
         }
     }
     pillars
+}
+
+/// Whether `pillar` (of `height`) touches `capsule` grown by [`KEPT_CLEAR_MARGIN_M`].
+fn touches(pillar: &Pillar, height: f32, capsule: &Capsule) -> bool {
+    let grown = Capsule {
+        radius: capsule.radius + KEPT_CLEAR_MARGIN_M,
+        ..*capsule
+    };
+    intersection_test(
+        &upright_pose(pillar.base.extend(0.0), height),
+        &Cylinder::new(0.5 * height, pillar.radius),
+        &Pose::IDENTITY,
+        &grown,
+    )
+    .is_ok_and(|hit| hit.intersecting)
 }
 
 /// Distance from `point` to the solid cylinder of `pillar` (0 inside).
@@ -201,13 +234,15 @@ fn cleared_field(field: &PillarField, field_path: &str, starts: &[Vec3]) -> Buil
     }
 }
 
-/// The pillars of the generator at `world.obstacle[index]`, as obstacles named `"{name} #{k}"`.
+/// The pillars of the generator at `world.obstacle[index]`, as obstacles named `"{name} #{k}"`,
+/// kept clear of the `starts` and the capsules `kept_clear` ([`generate_pillars`]).
 pub(super) fn build(
     spec: &ObstacleSpec,
     index: usize,
     field_path: &str,
     seed: RunSeed,
     starts: &[Vec3],
+    kept_clear: &[Capsule],
 ) -> Result<Vec<Obstacle>, Vec<BuildError>> {
     let ObstacleSpec::Pillars {
         name,
@@ -290,7 +325,7 @@ pub(super) fn build(
     }
     let mut rng = seed.stream(stream::WORLD_GENERATOR, index as u64);
     let base_name = display_name(name, "pillars", index);
-    Ok(generate_pillars(&field, starts, &mut rng)
+    Ok(generate_pillars(&field, starts, kept_clear, &mut rng)
         .into_iter()
         .enumerate()
         .map(|(k, p)| {
@@ -325,7 +360,7 @@ mod tests {
 
     fn draw(seed: u64, field: &PillarField, starts: &[Vec3]) -> Vec<Pillar> {
         let mut rng = RunSeed(seed).stream(stream::WORLD_GENERATOR, 0);
-        generate_pillars(field, starts, &mut rng)
+        generate_pillars(field, starts, &[], &mut rng)
     }
 
     #[test]
@@ -351,7 +386,7 @@ mod tests {
         )
         .unwrap();
         let build = |seed| {
-            super::super::build_world(&spec, RunSeed(seed), &[START], Path::new(".")).unwrap()
+            super::super::build_world(&spec, RunSeed(seed), &[START], &[], Path::new(".")).unwrap()
         };
         let poses = |w: &uavex_components::world::WorldGeometry| {
             w.obstacles().iter().map(|o| o.pose).collect::<Vec<_>>()
@@ -431,6 +466,53 @@ mod tests {
 
     /// The errors of a world with one pillar field (`extra` added to its table) for UAVs
     /// starting at `starts`; none when it builds.
+    /// An explorer's start capsule (`exploration::setup::StartCapsule`) removes exactly the
+    /// pillars that touch it: every other pillar is drawn as without it, and none kept comes
+    /// within its radius (measured in closed form: the capsule's axis is level, so the nearest
+    /// points of axis and pillar are apart by the horizontal gap and the height above the top).
+    #[test]
+    fn a_capsule_kept_clear_removes_the_pillars_that_touch_it_and_no_other() {
+        let (from, to, radius) = (Vec3::new(0.0, 0.0, 1.0), Vec3::new(2.0, 1.0, 1.0), 0.7);
+        let capsule = Capsule::new(from, to, radius);
+        let field = PillarField {
+            density: 0.5,
+            radius_min: 0.1,
+            radius_max: 0.4,
+            start_clearance: 0.0,
+            ..FIELD
+        };
+        // Distance from the level segment to the pillar's solid.
+        let gap = |p: &Pillar| {
+            let (a, b) = (from.truncate(), to.truncate());
+            let along = ((p.base - a).dot(b - a) / (b - a).length_squared()).clamp(0.0, 1.0);
+            let horizontal = (p.base.distance(a + along * (b - a)) - p.radius).max(0.0);
+            let vertical = (from.z - field.height).max(0.0);
+            horizontal.hypot(vertical)
+        };
+        let mut removed = 0;
+        for seed in 0..40 {
+            let all = draw(seed, &field, &[]);
+            let mut rng = RunSeed(seed).stream(stream::WORLD_GENERATOR, 0);
+            let kept = generate_pillars(&field, &[], &[capsule], &mut rng);
+            let expected: Vec<Pillar> = all
+                .iter()
+                .copied()
+                .filter(|p| gap(p) > radius + KEPT_CLEAR_MARGIN_M + 1e-4)
+                .collect();
+            // Pillars within rounding of the grown capsule may go either way.
+            let borderline = all
+                .iter()
+                .filter(|p| (gap(p) - radius - KEPT_CLEAR_MARGIN_M).abs() <= 1e-4)
+                .count();
+            assert!(kept.len() >= expected.len() && kept.len() <= expected.len() + borderline);
+            assert!(expected.iter().all(|p| kept.contains(p)), "seed {seed}");
+            assert!(kept.iter().all(|p| gap(p) >= radius), "seed {seed}");
+            removed += all.len() - kept.len();
+        }
+        // The field is dense enough that the capsule held pillars in many draws.
+        assert!(removed >= 10, "{removed}");
+    }
+
     fn field_errors(extra: &str, starts: &[Vec3]) -> Vec<BuildError> {
         let spec: WorldSpec = toml::from_str(&format!(
             r#"
@@ -444,7 +526,7 @@ mod tests {
             "#
         ))
         .unwrap();
-        super::super::build_world(&spec, RunSeed(0), starts, Path::new("."))
+        super::super::build_world(&spec, RunSeed(0), starts, &[], Path::new("."))
             .err()
             .unwrap_or_default()
     }
@@ -512,8 +594,8 @@ mod tests {
             "#,
         )
         .unwrap();
-        let errors =
-            super::super::build_world(&spec, RunSeed(0), &[START], Path::new(".")).unwrap_err();
+        let errors = super::super::build_world(&spec, RunSeed(0), &[START], &[], Path::new("."))
+            .unwrap_err();
         assert_eq!(errors[0].path, "world.obstacle[0].density");
         assert!(errors[0].message.contains("4000000"), "{}", errors[0]);
     }

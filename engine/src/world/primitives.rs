@@ -116,8 +116,7 @@ pub(super) fn build(
     }
 }
 
-/// A cylinder standing on `base` (centre of its bottom disc), axis +z. Parry's cylinder runs
-/// along its local +y: a quarter turn about x stands it up.
+/// A cylinder standing on `base` (centre of its bottom disc), axis +z.
 pub(super) fn upright_cylinder(
     name: String,
     source: &str,
@@ -128,10 +127,16 @@ pub(super) fn upright_cylinder(
     Obstacle::new(
         name,
         source,
-        Pose::from_parts(
-            base + Vec3::Z * (0.5 * height),
-            Quat::from_rotation_x(FRAC_PI_2),
-        ),
+        upright_pose(base, height),
         SharedShape::cylinder(0.5 * height, radius),
+    )
+}
+
+/// The pose of parry's cylinder of `height` standing on `base`: its centre half the height up,
+/// and a quarter turn about x, since parry's cylinder runs along its local +y.
+pub(super) fn upright_pose(base: Vec3, height: f32) -> Pose {
+    Pose::from_parts(
+        base + Vec3::Z * (0.5 * height),
+        Quat::from_rotation_x(FRAC_PI_2),
     )
 }

@@ -13,7 +13,7 @@ fn world_spec(toml_text: &str) -> WorldSpec {
 }
 
 fn build(spec: &WorldSpec, dir: &Path) -> Result<WorldGeometry, Vec<BuildError>> {
-    build_world(spec, RunSeed(1), &[Vec3::new(0.0, 0.0, 1.0)], dir)
+    build_world(spec, RunSeed(1), &[Vec3::new(0.0, 0.0, 1.0)], &[], dir)
 }
 
 /// Unit cube [0, 1]^3 as six quads (OBJ, counter-clockwise seen from outside).

@@ -379,7 +379,16 @@ fn merge_command(out: &std::path::Path, shards: &[PathBuf]) -> ExitCode {
         outln!("  missing: {id}");
     }
     let written = write_results(out);
-    if report.conflicts.is_empty() {
+    if !report.missing.is_empty() {
+        // The tables hold what the folders had; a script (a Slurm merge job) must still see
+        // that the result is not the plan's.
+        errln!(
+            "merge: {} of the plan's runs are in no folder; run their shards again (a sweep \
+             resumes) and merge again",
+            report.missing.len()
+        );
+    }
+    if report.conflicts.is_empty() && report.missing.is_empty() {
         written
     } else {
         ExitCode::FAILURE

@@ -321,11 +321,8 @@ impl Sim {
                 && tick.is_multiple_of(WALL_CHECK_TICKS)
                 && Instant::now() >= deadline
             {
-                let reason = format!(
-                    "wall-clock limit of {} s exceeded at {:.2} s simulated",
-                    limit.as_secs_f64(),
-                    self.time_s()
-                );
+                // The simulated time it stopped at is the summary's `mission_time_s`.
+                let reason = format!("wall-clock limit of {} s exceeded", limit.as_secs_f64());
                 self.world.resource_mut::<RunEnd>().0 = Some((Outcome::Failed, reason.clone()));
                 return (Outcome::Failed, reason);
             }

@@ -13,6 +13,8 @@
 //!   corner), 30 frames per second, each swept and integrated in turn into a map that starts
 //!   empty: the cost of frames in flight, where each sees new space next to saturated space.
 //!   Throughput is in frames.
+//! - `forest`: one thesis-camera frame (auto grid) swept in the exploration tests' forest of
+//!   round trunks, whose rays meet cylinders (cast in closed form, not by parry's GJK).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use glam::{DVec3, Quat, Vec3};
@@ -167,6 +169,50 @@ fn sense_and_map(c: &mut Criterion) {
     group.finish();
 }
 
+/// One thesis-camera frame (the auto grid) swept in the forest of the exploration tests
+/// (`tests/fixtures/forest_of_trunks.toml`, seed 1: 0.12 round trunks per m^2, a ball, a crate
+/// and a column), at its start, turning on the spot: rays against cylinders, cast in closed
+/// form (`uavex_components::world::cast_local_cylinder`).
+fn forest(c: &mut Criterion) {
+    let path = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/fixtures/forest_of_trunks.toml"
+    );
+    let loaded = scenario::load(path).expect("the forest fixture loads");
+    let start = Vec3::new(0.0, 0.0, 1.0);
+    let world = build_world(
+        &loaded.scenario.world,
+        RunSeed(1),
+        &[start],
+        &[],
+        &loaded.base_dir,
+    )
+    .expect("the forest builds");
+    let auto = camera_pattern(THESIS_CAMERA, RayGrid::Auto { resolution: 0.1 }, 0.5, 5.0).unwrap();
+    let mut scratch = SweepScratch::default();
+    let mut scan = Scan::default();
+    let mut group = c.benchmark_group("forest");
+    // A turn on the spot, one frame every 45 degrees.
+    let poses: Vec<SensorPose> = (0..8)
+        .map(|k| SensorPose {
+            origin: start,
+            rotation: Quat::from_rotation_z(k as f32 * std::f32::consts::FRAC_PI_4),
+        })
+        .collect();
+    group.throughput(Throughput::Elements(
+        (poses.len() * auto.directions.len()) as u64,
+    ));
+    group.bench_function("sweep_only_auto_turn_of_8_frames", |b| {
+        b.iter(|| {
+            for pose in &poses {
+                sweep(&auto, *pose, &world, None, &mut scratch, &mut scan, 0.0);
+                black_box(scan.endpoints.len());
+            }
+        })
+    });
+    group.finish();
+}
+
 /// Camera poses every 1/30 s along a loop around the pillars at 3 m/s, 1.25 m high, looking
 /// along the direction of travel (698 frames).
 fn flight_poses() -> Vec<SensorPose> {
@@ -304,7 +350,7 @@ fn flight(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, raycast, sense_and_map, flight);
+criterion_group!(benches, raycast, sense_and_map, forest, flight);
 
 /// `SENSING_PROFILE_FLIGHT=n cargo bench --bench sensing`: fly the flight n times and nothing
 /// else, for profilers that count instructions (callgrind), where criterion's timing loop

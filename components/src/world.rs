@@ -6,9 +6,11 @@
 //! can point at it. The engine builds a [`WorldGeometry`] from the scenario (`engine::world`) and
 //! derives the rapier colliders of the true flight from the same shapes.
 
+mod cylinder_ray;
 mod ground_truth;
 mod rays;
 
+pub use cylinder_ray::cast_local_cylinder;
 pub use ground_truth::VOXEL_SHRINK;
 pub use rays::PARALLEL_RAY_THRESHOLD;
 
@@ -16,6 +18,7 @@ use bevy_ecs::prelude::*;
 use parry3d::bounding_volume::Aabb;
 use parry3d::math::Pose;
 use parry3d::partitioning::{Bvh, BvhBuildStrategy};
+use parry3d::query::Ray;
 use parry3d::shape::{SharedShape, TriMeshFlags};
 
 /// One obstacle: a parry shape placed in the world.
@@ -53,6 +56,23 @@ impl Obstacle {
         self.shape
             .as_trimesh()
             .is_some_and(|mesh| mesh.flags().contains(TriMeshFlags::ORIENTED))
+    }
+
+    /// Where the ray (in the obstacle's frame) first meets the solid shape within `max_toi`, 0
+    /// from inside: parry's `cast_local_ray(ray, max_toi, true)`, but for a cylinder, which is
+    /// cast in closed form ([`cast_local_cylinder`]).
+    #[inline]
+    pub fn cast_local_ray(&self, ray: &Ray, max_toi: f32) -> Option<f32> {
+        match self.shape.as_cylinder() {
+            Some(cylinder) => cast_local_cylinder(cylinder, ray.origin, ray.dir, max_toi),
+            None => self.shape.cast_local_ray(ray, max_toi, true),
+        }
+    }
+
+    /// [`Self::cast_local_ray`] of a world-frame ray, moved into the obstacle's frame as parry's
+    /// `cast_ray` moves it.
+    pub fn cast_ray(&self, ray: &Ray, max_toi: f32) -> Option<f32> {
+        self.cast_local_ray(&ray.inverse_transform_by(&self.pose), max_toi)
     }
 
     /// World-frame bounding box.

@@ -37,10 +37,7 @@ impl WorldGeometry {
         let ray = Ray::new(origin, dir);
         self.bvh
             .cast_ray(&ray, max_distance, |leaf, best_so_far| {
-                let obstacle = &self.obstacles[leaf as usize];
-                obstacle
-                    .shape
-                    .cast_ray(&obstacle.pose, &ray, best_so_far, true)
+                self.obstacles[leaf as usize].cast_ray(&ray, best_so_far)
             })
             .map(|(leaf, distance)| (leaf as usize, distance))
     }

@@ -288,7 +288,12 @@ fn rapier_colliders_see_the_same_obstacles() {
                 (Some((index, d)), Some((handle, toi))) => {
                     hits += 1;
                     assert_eq!(colliders[handle].user_data, index as u128);
-                    assert!((d - toi).abs() < 1e-5);
+                    // Cylinders are cast in closed form here and by GJK in rapier, which
+                    // stops within a few millimetres of the surface (components'
+                    // `cylinder_ray` tests); every other shape by the same parry code.
+                    let cylinder = world.obstacles()[index].shape.as_cylinder().is_some();
+                    let tolerance = if cylinder { 5e-3 } else { 1e-5 };
+                    assert!((d - toi).abs() < tolerance, "{dir}: {d} {toi}");
                 }
                 other => panic!("disagreement for {dir}: {other:?}"),
             }

@@ -321,10 +321,9 @@ fn cast_sweep(
                 }
                 None => {
                     for lane in 0..LANES {
-                        let toi = obstacles[n.index].shape.cast_local_ray(
+                        let toi = obstacles[n.index].cast_local_ray(
                             &Ray::new(n.local_origin.into(), local.lane(lane)),
                             best[lane],
-                            true,
                         );
                         if let Some(toi) = toi
                             && toi < best[lane]

@@ -13,8 +13,9 @@
 //!   corner), 30 frames per second, each swept and integrated in turn into a map that starts
 //!   empty: the cost of frames in flight, where each sees new space next to saturated space.
 //!   Throughput is in frames.
-//! - `forest`: one thesis-camera frame (auto grid) swept in the exploration tests' forest of
-//!   round trunks, whose rays meet cylinders (cast in closed form, not by parry's GJK).
+//! - `forest`: one thesis-camera frame (auto grid) swept in the shipped forest of round trunks
+//!   (`scenarios/eaae_forest.toml`), whose rays meet cylinders (cast in closed form, not by
+//!   parry's GJK).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use glam::{DVec3, Quat, Vec3};
@@ -169,16 +170,13 @@ fn sense_and_map(c: &mut Criterion) {
     group.finish();
 }
 
-/// One thesis-camera frame (the auto grid) swept in the forest of the exploration tests
-/// (`tests/fixtures/forest_of_trunks.toml`, seed 1: 0.12 round trunks per m^2, a ball, a crate
+/// One thesis-camera frame (the auto grid) swept in the shipped forest
+/// (`scenarios/eaae_forest.toml`, seed 1: 0.12 round trunks per m^2, a ball, a crate
 /// and a column), at its start, turning on the spot: rays against cylinders, cast in closed
 /// form (`uavex_components::world::cast_local_cylinder`).
 fn forest(c: &mut Criterion) {
-    let path = concat!(
-        env!("CARGO_MANIFEST_DIR"),
-        "/tests/fixtures/forest_of_trunks.toml"
-    );
-    let loaded = scenario::load(path).expect("the forest fixture loads");
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/scenarios/eaae_forest.toml");
+    let loaded = scenario::load(path).expect("the shipped forest loads");
     let start = Vec3::new(0.0, 0.0, 1.0);
     let world = build_world(
         &loaded.scenario.world,

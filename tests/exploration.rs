@@ -176,11 +176,10 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
 /// explored), as 13 of 24 missions in a larger study did until their batteries were empty.
 #[test]
 fn a_forest_of_round_trunks_is_explored_to_the_end() {
-    let path = format!(
-        "{}/tests/fixtures/forest_of_trunks.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let path = format!("{}/scenarios/eaae_forest.toml", env!("CARGO_MANIFEST_DIR"));
+    let mut loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
+    // The limit the mission without the rule ran to (the shipped scene allows 600 s).
+    loaded.scenario.time_limit_s = 400.0;
     let summary = run_seed(&loaded, 2);
     let reachable = summary
         .exploration
@@ -202,10 +201,7 @@ fn a_forest_of_round_trunks_is_explored_to_the_end() {
 /// seeds lost them; now every seed builds, without the trunks the field drew there.
 #[test]
 fn every_seed_of_a_forest_leaves_the_explorers_start_capsule_clear() {
-    let path = format!(
-        "{}/tests/fixtures/forest_of_trunks.toml",
-        env!("CARGO_MANIFEST_DIR")
-    );
+    let path = format!("{}/scenarios/eaae_forest.toml", env!("CARGO_MANIFEST_DIR"));
     let loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
     let scenario = &loaded.scenario;
     let spec = &scenario.uavs[0];

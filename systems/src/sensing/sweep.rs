@@ -208,7 +208,7 @@ struct NearObstacle {
     aabb: Aabb,
     /// The shape when it is a box (most obstacles are): its ray test is parry's written out
     /// without branches (`super::box_cast`), inlined into the ray loop; other shapes are
-    /// cast through their table of methods.
+    /// cast by `Obstacle::cast_local_ray` (cylinders in closed form, the rest by parry).
     cuboid: Option<LocalBox>,
 }
 
@@ -246,9 +246,10 @@ struct Tiles<'a> {
 /// those whose bounding box meets the box of the range sphere: found once per sweep, with the
 /// origin moved into each one's frame once. Each ray is then cast against those few shapes
 /// directly, skipping the hierarchy's traversal, which costs more than the box-shaped
-/// obstacles' own ray tests (benches/sensing.rs). The per-shape test is parry's own
-/// (`cast_ray` is `cast_local_ray` of the ray moved into the shape's frame by the same two
-/// operations), and the nearest hit closer than the range wins, as in the hierarchy's search.
+/// obstacles' own ray tests (benches/sensing.rs). The per-shape test is the hierarchy's own
+/// (`Obstacle::cast_ray` is `cast_local_ray` of the ray moved into the shape's frame by the
+/// same two operations), and the nearest hit closer than the range wins, as in the
+/// hierarchy's search.
 /// The obstacles are tried nearest box first, and a ray stops trying once the next box lies
 /// beyond its nearest hit so far: the shape in that box can only be hit farther away (in a
 /// room, most rays end on the floor, a wall or a pillar before reaching the others' boxes).

@@ -34,6 +34,8 @@ pub mod traversable;
 #[cfg(test)]
 mod tests;
 #[cfg(test)]
+mod tests_braking;
+#[cfg(test)]
 mod tests_planner;
 #[cfg(test)]
 mod tests_search;

@@ -10,13 +10,17 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use uavex_components::airframe::Airframe;
 use uavex_components::trajectory::{PiecewisePolynomial, Trajectory, TrajectoryPoint};
 
-fn kingfisher() -> DynamicLimits {
+pub(super) fn kingfisher() -> DynamicLimits {
     DynamicLimits::of(&Airframe::kingfisher())
 }
 
 /// Every 0.05 m of the trajectory is traversable (no escape allowance) and the peaks hold the
 /// limits; returns the end point.
-fn assert_safe(grid: &TraversableGrid, trajectory: &PiecewisePolynomial, limits: &DynamicLimits) {
+pub(super) fn assert_safe(
+    grid: &TraversableGrid,
+    trajectory: &PiecewisePolynomial,
+    limits: &DynamicLimits,
+) {
     let step = 0.05 / limits.max_velocity;
     let n = (trajectory.duration() / step).ceil() as usize;
     for i in 0..=n {
@@ -36,7 +40,7 @@ fn assert_safe(grid: &TraversableGrid, trajectory: &PiecewisePolynomial, limits:
     }
 }
 
-fn end_of(trajectory: &PiecewisePolynomial) -> TrajectoryPoint {
+pub(super) fn end_of(trajectory: &PiecewisePolynomial) -> TrajectoryPoint {
     trajectory.sample(trajectory.duration())
 }
 
@@ -92,7 +96,7 @@ fn unreachable_goals_and_bad_input_are_errors() {
 }
 
 /// An open room 10.4 x 6.4 x 2.4 m, all free.
-fn open_room() -> TestMap {
+pub(super) fn open_room() -> TestMap {
     let mut map = TestMap::new(DVec3::ZERO, DVec3::new(10.4, 6.4, 2.4));
     map.fill_all(FREE);
     map
@@ -499,121 +503,4 @@ fn skipping_open_space_stops_short_of_a_wall_met_at_full_speed() {
             first_untraversable_every_sample(&grid, &trajectory, 0.0, limits.max_velocity)
         );
     }
-}
-
-/// A UAV at 2.48 m/s still accelerating away at 3.6 m/s^2 (the start of a decision of an EAAE
-/// Pillars mission, seed 2), 4.6 m from the room's end, whose goal lies behind it.
-fn turning_back() -> (TestMap, TrajectoryPoint, DVec3) {
-    let mut map = TestMap::new(DVec3::ZERO, DVec3::new(6.4, 6.4, 1.6));
-    map.fill_all(FREE);
-    let start = TrajectoryPoint {
-        position: DVec3::new(1.5, 1.5, 0.8),
-        velocity: DVec3::new(0.06, 2.48, 0.0),
-        acceleration: DVec3::new(0.09, 3.6, 0.0),
-        jerk: DVec3::new(-0.11, -4.15, 0.0),
-        yaw: std::f64::consts::FRAC_PI_2,
-        ..TrajectoryPoint::default()
-    };
-    (map, start, DVec3::new(1.5, 0.6, 0.8))
-}
-
-/// A decision's candidate along `path` ([`plan_along_seen`], with fresh memos).
-fn candidate(
-    grid: &TraversableGrid,
-    start: &TrajectoryPoint,
-    path: &[DVec3],
-    limits: &DynamicLimits,
-) -> Result<GlobalPlan, crate::trajectory::PlanError> {
-    let (mut sight, braking) = (SightMemo::new(grid), BrakingMemo::new());
-    plan_along_seen(&mut sight, &braking, start, path, None, limits)
-}
-
-#[test]
-fn a_start_that_turns_back_stops_first_then_goes() {
-    let (mut map, start, goal) = turning_back();
-    let grid = map.grid(0.27);
-    let limits = kingfisher();
-    let plan = plan_global(&grid, &start, goal, None, &limits).unwrap();
-    assert_safe(&grid, &plan.trajectory, &limits);
-    let first = plan.trajectory.sample(0.0);
-    assert!(first.velocity.distance(start.velocity) < 1e-9);
-    assert!(first.acceleration.distance(start.acceleration) < 1e-9);
-    assert!(end_of(&plan.trajectory).position.distance(goal) < 1e-9);
-    // It stops ahead (the path's second point), then turns back.
-    let braking = Braking::of(&grid, &start, &limits).expect("room to brake");
-    let stop = braking.stop.position;
-    assert_eq!(plan.path[1], stop);
-    assert!(
-        stop.y > start.position.y
-            && stop.x == start.position.x + 0.06 / 2.48 * (stop.y - start.position.y)
-    );
-    let join = braking.trajectory.duration();
-    let at_stop = plan.trajectory.sample(join);
-    assert!(at_stop.position.distance(stop) < 1e-9 && at_stop.velocity.length() < 1e-9);
-    // A decision's candidate stops first at once, on the shared braking leg: the same plan.
-    let path = find_path(&grid, start.position, goal, usize::MAX).unwrap();
-    assert_eq!(candidate(&grid, &start, &path, &limits).unwrap(), plan);
-}
-
-#[test]
-fn the_local_planner_turns_back_smoothly_where_it_can_and_a_candidate_stops_first() {
-    let mut map = open_room();
-    let grid = map.grid(0.27);
-    let limits = kingfisher();
-    // 1.5 m/s along +y in the middle of the room, the goal 1.5 m behind.
-    let start = TrajectoryPoint {
-        velocity: DVec3::new(0.0, 1.5, 0.0),
-        ..TrajectoryPoint::at_rest(DVec3::new(3.2, 2.5, 0.8), std::f64::consts::FRAC_PI_2)
-    };
-    let goal = DVec3::new(3.2, 1.0, 0.8);
-    let path = find_path(&grid, start.position, goal, usize::MAX).unwrap();
-    let stop = Braking::of(&grid, &start, &limits)
-        .expect("room to brake")
-        .stop
-        .position;
-    let smooth = plan_along(&grid, &start, &path, None, &limits).unwrap();
-    assert_safe(&grid, &smooth.trajectory, &limits);
-    assert!(!smooth.path.contains(&stop));
-    let candidate = candidate(&grid, &start, &path, &limits).unwrap();
-    assert_safe(&grid, &candidate.trajectory, &limits);
-    assert_eq!(candidate.path[1], stop);
-}
-
-#[test]
-fn a_braking_leg_stops_ahead_without_running_past_its_stop() {
-    let (mut map, start, _) = turning_back();
-    let grid = map.grid(0.27);
-    let limits = kingfisher();
-    let braking = Braking::of(&grid, &start, &limits).expect("room to brake");
-    assert_safe(&grid, &braking.trajectory, &limits);
-    let end = end_of(&braking.trajectory);
-    assert!(end.position.distance(braking.stop.position) < 1e-9);
-    assert!(end.velocity.length() < 1e-9 && end.acceleration.length() < 1e-9);
-    // Still accelerating away, it needs more than the 0.77 m of v^2 / 2 amax (measured: four
-    // times that, 3.1 m in 1.8 s), and never runs more than 10 % (+ 5 cm) past its stop.
-    let stopping_m = start.velocity.length_squared() / (2.0 * limits.max_acceleration);
-    let ahead = start.velocity.normalize();
-    let distance = (braking.stop.position - start.position).dot(ahead);
-    assert!(distance > 1.4 * stopping_m, "{distance} m");
-    let duration = braking.trajectory.duration();
-    let farthest = (0..=200)
-        .map(|i| braking.trajectory.position(duration * f64::from(i) / 200.0))
-        .map(|p| (p - start.position).dot(ahead))
-        .fold(f64::NEG_INFINITY, f64::max);
-    assert!(
-        farthest <= 1.1 * distance + 0.05,
-        "{farthest} m for a stop at {distance} m"
-    );
-
-    // A slow start needs no braking leg; one with a wall within its stopping distance has none.
-    let slow = TrajectoryPoint {
-        velocity: DVec3::new(0.0, 0.6, 0.0),
-        acceleration: DVec3::ZERO,
-        jerk: DVec3::ZERO,
-        ..start
-    };
-    assert!(Braking::of(&grid, &slow, &limits).is_none());
-    map.fill(IVec3::new(0, 20, 0), IVec3::new(63, 21, 15), OCCUPIED);
-    let grid = map.grid(0.27);
-    assert!(Braking::of(&grid, &start, &limits).is_none());
 }

@@ -19,3 +19,10 @@ pub(super) fn per_axis<T: Copy, U>(a: [T; 3], f: impl Fn(T) -> U) -> [U; 3] {
 pub(super) fn by_axis<U>(f: impl Fn(usize) -> U) -> [U; 3] {
     [f(0), f(1), f(2)]
 }
+
+/// All ones if `c`, else zero: a branch-free select (`x & mask(c)`) for the walks' choice of
+/// axis, whose outcome no predictor knows.
+#[inline(always)]
+pub(super) fn mask(c: bool) -> i64 {
+    -i64::from(c)
+}

@@ -27,7 +27,7 @@
 //! builds without the profile): past the first brick that is not full, full bricks come one or
 //! two at a time, and the cubes cross them from the chunk the walk already holds.
 
-use super::axes::{by_axis, per_axis};
+use super::axes::{by_axis, mask, per_axis};
 use super::cube::{CubeCrossing, DT_COMPARE_CAP, LeavingFace};
 use super::full_bricks::FullBricks;
 use glam::IVec3;
@@ -152,12 +152,6 @@ impl<'a> BrickRuns<'a> {
             }
         }))
     }
-}
-
-/// All ones if `c`, else zero.
-#[inline(always)]
-fn mask(c: bool) -> i64 {
-    -i64::from(c)
 }
 
 #[cfg(test)]

@@ -14,14 +14,8 @@
 //! `a` is at `t_a + j dt_a` exactly, so the cube's faces and the crossings before them are
 //! computed, not accumulated, and equal the voxel walk's to the last bit.
 
-use super::axes::{by_axis, per_axis};
+use super::axes::{by_axis, mask, per_axis};
 use uavex_components::map::block_bricks;
-
-/// All ones if `c`, else zero.
-#[inline(always)]
-fn mask(c: bool) -> i64 {
-    -i64::from(c)
-}
 
 /// Intervals above this (2^47 fixed point: 8 segment lengths) are clamped to it in the
 /// comparisons: an axis that slow reaches no second boundary before the segment's end (2^44),

@@ -12,6 +12,7 @@
 //!   grid (`full_bricks`).
 //! - `rays`: a scan's rays checked, in voxel units, and prepared for the walks.
 //! - [`integrate`]: one scan into the map over any [`ChunkAccess`] (plain function).
+//! - `walk`: the walk proper, voxel by voxel in a chunk, past the saturated cubes it meets.
 //! - [`report`]: [`ScanReport`], what an integration did (and, asked for, how it skipped).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
 //! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
@@ -38,6 +39,7 @@ pub mod state_changes;
 pub mod store;
 pub mod system;
 pub mod update;
+mod walk;
 
 pub use integrate::{ChunkAccess, ScanError, ScanRays, integrate_scan, integrate_scan_tallied};
 pub use read::{GroundTruth, MapReader, OccupancyMap, WorldVoxels, map_accuracy};

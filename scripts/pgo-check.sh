@@ -29,12 +29,12 @@ for binary in target/release/uavex target/release/deps/decision-*; do
         echo "MISSED:  $binary ($name is not in the profile: remake it with scripts/pgo-train.sh)"
         status=1
     fi
-    # The function the map update's walk is inlined into (the one holding most of
-    # integrate.rs's lines) must not call a `core::array` function: an `array::map` left out
+    # The function the map update's walk is inlined into (the one holding most of the lines
+    # of mapping/walk.rs) must not call a `core::array` function: an `array::map` left out
     # of line there (`try_map`) spilled the walk's registers and cost the map update 13 %
     # (mapping/axes.rs).
     walk=$(objdump -d --no-show-raw-insn -C -l "$binary" 2>/dev/null \
-        | awk '/^[0-9a-f]+ </ { fn = $0 } /mapping\/integrate\.rs:/ { print fn }' \
+        | awk '/^[0-9a-f]+ </ { fn = $0 } /mapping\/walk\.rs:/ { print fn }' \
         | sort | uniq -c | sort -rn | head -1 | sed 's/^ *[0-9]* //')
     calls=$(objdump -d --no-show-raw-insn -C "$binary" \
         | awk -v walk="$walk" '$0 == walk { inside = 1; next } /^[0-9a-f]+ </ { inside = 0 }

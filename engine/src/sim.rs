@@ -10,6 +10,7 @@ use crate::world::{build_world, check_starts_with_radii, sensor_bundle};
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::ScheduleSystem;
 use glam::{DVec3, Vec3};
+use parry3d::shape::Capsule;
 use std::time::{Duration, Instant};
 use uavex_components::airframe::Airframe;
 use uavex_components::map::{MapConfig, MapSettings};
@@ -76,16 +77,21 @@ impl Sim {
             p_max: scenario.map.p_max,
         })
         .map_err(|e| loaded.errors([("map", e.to_string())]))?;
-        // What explorers need clear ahead of their starts, which seeded fields leave free.
-        let kept_clear: Vec<_> = scenario
+        // What seeded fields leave free: every UAV's body where it starts (the start check
+        // below could otherwise refuse a seed that drew a pillar into it, whatever the field's
+        // `start_clearance`) and what explorers need clear ahead of their starts.
+        let bodies = starts.iter().zip(&airframes).map(|(&start, airframe)| {
+            Capsule::new(start, start, airframe.bounding_radius() as f32)
+        });
+        let capsules = scenario
             .uavs
             .iter()
             .zip(&airframes)
             .filter_map(|(spec, airframe)| {
                 StartCapsule::of_explorer(spec, airframe, map.resolution())
             })
-            .map(|capsule| capsule.shape())
-            .collect();
+            .map(|capsule| capsule.shape());
+        let kept_clear: Vec<Capsule> = bodies.chain(capsules).collect();
         let geometry = build_world(
             &scenario.world,
             run_seed,

@@ -7,9 +7,10 @@
 //! the true expected number per square metre whatever the area. Pillars may overlap (their union
 //! is the obstacle). Pillars closer than `start_clearance` to a UAV start are then removed, which
 //! leaves the process unchanged outside those discs, and so are pillars that touch a space a UAV
-//! needs clear at its start whatever the field asks (an explorer's start capsule,
-//! `exploration::setup::StartCapsule`): without that, every seed that drew a trunk into it would
-//! be refused when the run is built, and a sweep over seeds would lose those runs.
+//! needs clear at its start whatever the field asks (its body's bounding sphere, and an
+//! explorer's start capsule, `exploration::setup::StartCapsule`): without that, every seed that
+//! drew a trunk into it would be refused when the run is built, and a sweep over seeds would
+//! lose those runs.
 //!
 //! Randomness: `RunSeed::stream(stream::WORLD_GENERATOR, i)` for the generator at
 //! `world.obstacle[i]`; the count is drawn first, then per pillar x, y and radius, so one

@@ -2,12 +2,10 @@
 //! into a UAV's body where it starts are left out, so a sweep over seeds loses no run to a
 //! start refused for a pillar (as it did, for explorers' start capsules, before 2026-12-07).
 
-use uavex::components::sim::RunSeed;
+mod common;
+
 use uavex::components::world::WorldGeometry;
 use uavex::engine::flight::airframe_of;
-use uavex::engine::scenario::parse_str;
-use uavex::engine::sim::Sim;
-use uavex::engine::world::build_world;
 
 /// A dense field (two trunks per square metre) that asks for no clearance around a scripted
 /// UAV's start.
@@ -43,37 +41,13 @@ waypoints = [[0.0, 0.0, 1.0]]
 
 #[test]
 fn a_seeded_field_leaves_every_uavs_start_body_clear() {
-    let loaded = parse_str(DENSE_FIELD, "dense_field.toml").unwrap_or_else(|e| panic!("{e}"));
+    let loaded = common::scenario(DENSE_FIELD);
     let scenario = &loaded.scenario;
     let spec = &scenario.uavs[0];
     let radius = airframe_of(spec, 0).unwrap().bounding_radius() as f32;
     let start = glam::DVec3::from_array(spec.start.position).as_vec3();
     let blocked = |world: &WorldGeometry| world.intersects_ball(start, radius);
-    let mut drawn_into_it = Vec::new();
-    for seed in 1..=20 {
-        // The same field with nothing kept clear: what the start check used to refuse.
-        let bare = build_world(
-            &scenario.world,
-            RunSeed(seed),
-            &[start],
-            &[],
-            &loaded.base_dir,
-        )
-        .unwrap_or_else(|e| panic!("{e:?}"));
-        if blocked(&bare) {
-            drawn_into_it.push(seed);
-        }
-        let sim = Sim::build(&loaded, seed).unwrap_or_else(|e| panic!("seed {seed}: {e}"));
-        let world = sim.world.resource::<WorldGeometry>();
-        assert!(!blocked(world), "seed {seed}");
-        // Only trunks that touched the body went.
-        let removed = bare.obstacles().len() - world.obstacles().len();
-        assert_eq!(
-            removed > 0,
-            blocked(&bare),
-            "seed {seed}: {removed} removed"
-        );
-    }
+    let drawn_into_it = common::seeds_kept_clear(&loaded, 1..=20, blocked, usize::MAX);
     // The field is dense enough that the test means something: 11 of the 20 seeds drew a
     // trunk into the body, and were refused before.
     assert_eq!(drawn_into_it, [1, 2, 6, 7, 9, 14, 15, 16, 18, 19, 20]);

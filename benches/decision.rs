@@ -12,7 +12,9 @@
 //! - energy: `roll_out_candidates` on those candidates;
 //! - 2-means: `divisive_two_means` alone on the frontier points.
 //!
-//! It prints p50 / p95 / max per part and of the sum (clustering + trajectories + energy), and
+//! It prints p50 / p95 / max per part and of the sum (clustering + trajectories + energy), how
+//! many candidates the time allocation stretched beyond [`STRETCHED`] times the rest-to-rest
+//! time of their paths (the README's known limit of a start accelerating hard), and
 //! a digest of every planned candidate (target, viewpoint, trajectory bits), so that a change
 //! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
 //! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
@@ -53,7 +55,8 @@ use uavex_systems::flight::{FlightState, RolloutConfig};
 use uavex_systems::frontier::{cluster_frontier, divisive_two_means};
 use uavex_systems::mapping::MapReader;
 use uavex_systems::planning::{
-    BrakingMemo, SightMemo, Traversability, TraversableGrid, find_paths, plan_along_seen,
+    BrakingMemo, GlobalPlan, SightMemo, Traversability, TraversableGrid, find_paths,
+    plan_along_seen,
 };
 use uavex_systems::trajectory::DynamicLimits;
 
@@ -148,6 +151,22 @@ fn plan(s: &Snapshot) -> Vec<PlannedCandidate> {
     .1
 }
 
+/// A candidate whose trajectory lasts more than this many times the rest-to-rest time of its
+/// path's legs counts as stretched ([`stretch`]). From rest a minimum-snap trajectory takes
+/// 1.1-1.5 times that time.
+const STRETCHED: f64 = 3.0;
+
+/// How far the time allocation stretched a candidate: its duration over the fastest
+/// rest-to-rest time of its path's legs ([`DynamicLimits::rest_to_rest_time`]).
+fn stretch(plan: &GlobalPlan, limits: &DynamicLimits) -> f64 {
+    let needed: f64 = plan
+        .path
+        .windows(2)
+        .map(|leg| limits.rest_to_rest_time(leg[0].distance(leg[1])))
+        .sum();
+    plan.trajectory.duration() / needed
+}
+
 fn digest(planned: &[PlannedCandidate]) -> u64 {
     let mut h = DefaultHasher::new();
     for c in planned {
@@ -213,7 +232,11 @@ fn explain(k: usize, s: &Snapshot) {
         let result = plan_along_seen(&mut sight, &braking, start, &path, goal.yaw, &s.limits);
         let ms = started.elapsed().as_secs_f64() * 1e3;
         let outcome = match result {
-            Ok(plan) => format!("ok, {:.2} s", plan.trajectory.duration()),
+            Ok(plan) => format!(
+                "ok, {:.2} s ({:.1}x rest to rest)",
+                plan.trajectory.duration(),
+                stretch(&plan, &s.limits)
+            ),
             Err(e) => e.to_string(),
         };
         println!(
@@ -270,6 +293,7 @@ fn main() {
             (vec![], vec![], vec![], vec![], vec![]);
         let mut candidates = 0usize;
         let mut targets = 0usize;
+        let (mut stretched, mut most_stretched) = (0usize, 0.0f64);
         let mut rows = Vec::new();
         for (k, s) in snapshots.iter().enumerate() {
             let (t_ms, planned) = pool.install(|| fastest_ms(|| plan(s)));
@@ -282,6 +306,11 @@ fn main() {
             });
             candidates += planned.len();
             targets += s.clusters.len();
+            for candidate in &planned {
+                let stretch = stretch(&candidate.plan, &s.limits);
+                stretched += usize::from(stretch > STRETCHED);
+                most_stretched = most_stretched.max(stretch);
+            }
             if let Some(file) = &mut digest_file {
                 writeln!(
                     file,
@@ -327,6 +356,10 @@ fn main() {
             snapshots.len(),
             targets as f64 / n,
             candidates as f64 / n
+        );
+        println!(
+            "  candidates stretched beyond {STRETCHED}x the rest-to-rest time of their paths: \
+             {stretched} of {candidates} (at most {most_stretched:.1}x)"
         );
         rows.sort_by(|a, b| b.0.total_cmp(&a.0));
         for (total, k, clusters, planned, c, t, e) in rows.iter().take(top) {

@@ -93,6 +93,18 @@ impl DynamicLimits {
         ))
     }
 
+    /// The time of the fastest rest-to-rest move over `distance` (m) within the limits: the
+    /// trapezoidal speed profile (a triangle when `vmax` is not reached). The time allocation
+    /// starts from it; a minimum-snap trajectory from rest takes some 1.1-1.5 times as long.
+    pub fn rest_to_rest_time(&self, distance: f64) -> f64 {
+        let (v, a) = (self.max_velocity, self.max_acceleration);
+        if distance <= v * v / a {
+            2.0 * (distance / a).sqrt()
+        } else {
+            distance / v + v / a
+        }
+    }
+
     fn check(&self) -> Result<(), PlanError> {
         for (name, value) in [
             ("max_velocity", self.max_velocity),
@@ -319,7 +331,6 @@ fn initial_durations(
     yaws: &[Option<f64>],
     limits: &DynamicLimits,
 ) -> Result<Vec<f64>, PlanError> {
-    let (v, a) = (limits.max_velocity, limits.max_acceleration);
     let mut previous_position = start.position;
     let mut previous_yaw = start.yaw;
     let mut durations = Vec::with_capacity(waypoints.len());
@@ -329,11 +340,7 @@ fn initial_durations(
         if distance < 1e-6 && turn < 1e-6 {
             return Err(PlanError::CoincidentWaypoints { index });
         }
-        let travel = if distance <= v * v / a {
-            2.0 * (distance / a).sqrt()
-        } else {
-            distance / v + v / a
-        };
+        let travel = limits.rest_to_rest_time(distance);
         durations.push(travel.max(turn / limits.max_yaw_rate).max(0.05));
         previous_position = waypoint.position;
         if let Some(y) = yaw {

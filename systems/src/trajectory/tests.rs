@@ -51,6 +51,18 @@ fn sampled_peaks_with_yaw_rate(
     peaks
 }
 
+/// The trapezoidal profile at vmax 5, amax 4: a triangle up to `v^2 / a` = 6.25 m (1 m:
+/// `2 sqrt(1 / 4)` = 1 s), then `d / v + v / a` (10 m: 2 + 1.25 s), the two equal at 6.25 m.
+#[test]
+fn rest_to_rest_time_is_the_trapezoidal_profile() {
+    let time = |distance| limits().rest_to_rest_time(distance);
+    assert!((time(1.0) - 1.0).abs() < 1e-12);
+    assert!((time(10.0) - 3.25).abs() < 1e-12);
+    assert!((time(6.25) - 2.5).abs() < 1e-12);
+    assert!((time(6.25 + 1e-9) - 2.5).abs() < 1e-9);
+    assert_eq!(time(0.0), 0.0);
+}
+
 #[test]
 fn passes_through_waypoints_and_is_continuous_up_to_snap() {
     let start = TrajectoryPoint::at_rest(DVec3::new(0.0, 0.0, 1.0), 0.0);

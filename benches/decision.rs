@@ -152,8 +152,9 @@ fn plan(s: &Snapshot) -> Vec<PlannedCandidate> {
 }
 
 /// A candidate whose trajectory lasts more than this many times the rest-to-rest time of its
-/// path's legs counts as stretched ([`stretch`]). From rest a minimum-snap trajectory takes
-/// 1.1-1.5 times that time.
+/// path's legs counts as stretched ([`stretch`]). Half the allocations of a Pillars mission
+/// end within 1.1 times that time, nine in ten within 2.3 (docs/performance.md, fifty-first
+/// session).
 const STRETCHED: f64 = 3.0;
 
 /// How far the time allocation stretched a candidate: its duration over the fastest

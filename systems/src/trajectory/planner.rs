@@ -95,7 +95,8 @@ impl DynamicLimits {
 
     /// The time of the fastest rest-to-rest move over `distance` (m) within the limits: the
     /// trapezoidal speed profile (a triangle when `vmax` is not reached). The time allocation
-    /// starts from it; a minimum-snap trajectory from rest takes some 1.1-1.5 times as long.
+    /// starts from it; the allocations of a Pillars mission end at 1.1 times it in the median
+    /// (docs/performance.md, fifty-first session).
     pub fn rest_to_rest_time(&self, distance: f64) -> f64 {
         let (v, a) = (self.max_velocity, self.max_acceleration);
         if distance <= v * v / a {

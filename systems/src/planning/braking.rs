@@ -18,6 +18,10 @@
 //! needs several stopping distances (3.1 m in 1.8 s for the start above, against the 0.77 m
 //! of `v^2 / 2 amax`). The braking depends on the start alone, so the plans of one decision
 //! share it ([`BrakingMemo`]).
+//!
+//! The leg's stop also says how near the start a trajectory can be pinned: a waypoint short of
+//! it lies closer than the start can stop, and a fit that adds one is compared with stopping
+//! first ([`BrakingMemo::pinned_within`], [`super::global`]).
 
 use super::check::first_untraversable;
 use super::traversable::TraversableGrid;
@@ -54,13 +58,12 @@ impl Braking {
         start: &TrajectoryPoint,
         limits: &DynamicLimits,
     ) -> Option<Self> {
-        let speed = start.velocity.length();
-        let stopping_m = speed * speed / (2.0 * limits.max_acceleration);
+        let stopping_m = stopping_distance(start, limits);
         // (A non-finite velocity has no braking leg either.)
         if !stopping_m.is_finite() || stopping_m < MIN_STOPPING_M {
             return None;
         }
-        let ahead = start.velocity / speed;
+        let ahead = start.velocity / start.velocity.length();
         for multiple in STOPPING_MULTIPLES {
             let distance = multiple * stopping_m;
             let position = start.position + distance * ahead;
@@ -96,6 +99,12 @@ impl Braking {
     }
 }
 
+/// The distance a start at its speed stops in at the largest deceleration, `v^2 / 2 amax` (m).
+pub fn stopping_distance(start: &TrajectoryPoint, limits: &DynamicLimits) -> f64 {
+    let speed = start.velocity.length();
+    speed * speed / (2.0 * limits.max_acceleration)
+}
+
 /// How far along `ahead` from `origin` the trajectory gets (m).
 fn overrun(trajectory: &PiecewisePolynomial, origin: DVec3, ahead: DVec3) -> f64 {
     let duration = trajectory.duration();
@@ -115,6 +124,27 @@ pub struct BrakingMemo(OnceLock<Option<Braking>>);
 impl BrakingMemo {
     pub fn new() -> Self {
         Self::default()
+    }
+
+    /// The braking leg of `start` if a waypoint `distance_m` from it lies short of the leg's
+    /// stop: a trajectory through it is pinned closer to the start than the start can stop
+    /// ([`super::global`]). The leg is computed only for a waypoint within the farthest stop
+    /// tried.
+    pub fn pinned_within(
+        &self,
+        grid: &TraversableGrid,
+        start: &TrajectoryPoint,
+        limits: &DynamicLimits,
+        distance_m: f64,
+    ) -> Option<&Braking> {
+        let farthest_stop_m =
+            STOPPING_MULTIPLES[STOPPING_MULTIPLES.len() - 1] * stopping_distance(start, limits);
+        // (False for a NaN, and for the infinite distance of a fit that added no waypoint.)
+        let within_reach = distance_m < farthest_stop_m;
+        within_reach
+            .then(|| self.get(grid, start, limits))
+            .flatten()
+            .filter(|b| distance_m < b.stop.position.distance(start.position))
     }
 
     /// [`Braking::of`], computed once.

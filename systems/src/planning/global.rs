@@ -17,6 +17,16 @@
 //! that must reverse the start's motion within one long segment runs on the way the UAV went.
 //! The local planner does so only when it finds no other trajectory.
 //!
+//! A fit that adds a waypoint closer to a moving start than the start's braking leg stops is
+//! also planned stopping first, and the faster of the two is kept (both planners). Such a
+//! waypoint pins the polynomial near the start; the start's motion must loop to pass it, and
+//! the time allocation, which scales every segment alike, stretches the whole trajectory. In
+//! the decisions of five EAAE Pillars missions (decision bench) 65 of 7,228 candidates had
+//! lasted more than three times the rest-to-rest time of their paths, up to 40 times; with
+//! stopping first 17 of 7,263 did, at most 5.8 times (docs/performance.md, fifty-second
+//! session). The rest stretch for a reason: a short hop with a half turn of the heading, or a
+//! fast start whose goal lies behind it.
+//!
 //! Headings: the heading turns smoothly from the start's to `end_yaw` (without one, to the
 //! direction of the path's last leg); the waypoints between leave it free, and the time
 //! allocation holds its rate within `max_yaw_rate`. Facing the direction of travel at every
@@ -26,7 +36,7 @@
 //! the limit those turns stretched the trajectories, and the protocol's missions took up to
 //! 8 % longer (docs/performance.md, forty-eighth session).
 
-use super::braking::{Braking, BrakingMemo};
+use super::braking::{Braking, BrakingMemo, stopping_distance};
 use super::check::first_untraversable;
 use super::search::{MIN_POINT_SEPARATION_M, find_path, path_length, shortcut_indices};
 use super::sight::SightMemo;
@@ -34,7 +44,7 @@ use super::traversable::TraversableGrid;
 use crate::behaviour::waypoints::follow_headings;
 use crate::trajectory::{DynamicLimits, PlanError, Waypoint, plan_min_snap};
 use glam::DVec3;
-use uavex_components::trajectory::{PiecewisePolynomial, TrajectoryPoint};
+use uavex_components::trajectory::{PiecewisePolynomial, Trajectory, TrajectoryPoint};
 
 /// A planned global trajectory and the path it follows.
 #[derive(Debug, Clone, PartialEq)]
@@ -138,15 +148,26 @@ fn plan_along_by(
         return stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
     }
     let kept = beyond_stopping(&kept, &original, start, limits);
-    let error = match fit(grid, start, &original, &kept, end_yaw, limits) {
-        Ok(trajectory) => {
-            let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
-            return Ok(GlobalPlan {
-                path_length_m: path_length(&shortened),
-                path: shortened,
-                trajectory,
-            });
+    let fitted = fit(grid, start, &original, &kept, end_yaw, limits);
+    let smooth = fitted.trajectory.map(|trajectory| {
+        let shortened: Vec<DVec3> = kept.iter().map(|&i| original[i]).collect();
+        GlobalPlan {
+            path_length_m: path_length(&shortened),
+            path: shortened,
+            trajectory,
         }
+    });
+    // Pinned closer to the start than it can stop: stopping first may be faster (module doc).
+    if let Some(braking) = braking.pinned_within(grid, start, limits, fitted.nearest_added_m) {
+        let stopped = stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
+        return match (smooth, stopped) {
+            (Ok(smooth), Ok(stopped)) => Ok(faster(smooth, stopped)),
+            (Ok(plan), Err(_)) | (Err(_), Ok(plan)) => Ok(plan),
+            (Err(error), Err(_)) => Err(error),
+        };
+    }
+    let error = match smooth {
+        Ok(plan) => return Ok(plan),
         Err(error) => error,
     };
     // Stuck turning back: stop first after all.
@@ -158,6 +179,15 @@ fn plan_along_by(
             .map_err(|_| error);
     }
     Err(error)
+}
+
+/// The shorter in time of two plans (the first on a tie).
+fn faster(a: GlobalPlan, b: GlobalPlan) -> GlobalPlan {
+    if b.trajectory.duration() < a.trajectory.duration() {
+        b
+    } else {
+        a
+    }
 }
 
 /// The braking leg of a moving start, then the trajectory from rest where it stops along
@@ -173,7 +203,7 @@ fn stop_then_go(
 ) -> Result<GlobalPlan, PlanError> {
     original.insert(0, braking.stop.position);
     let kept = shortcut_indices(&original, sees);
-    let onward = fit(grid, &braking.stop, &original, &kept, end_yaw, limits)?;
+    let onward = fit(grid, &braking.stop, &original, &kept, end_yaw, limits).trajectory?;
     let mut segments = braking.trajectory.segments().to_vec();
     segments.extend_from_slice(onward.segments());
     let trajectory = PiecewisePolynomial::new(segments).map_err(PlanError::Internal)?;
@@ -201,8 +231,7 @@ pub fn beyond_stopping(
     start: &TrajectoryPoint,
     limits: &DynamicLimits,
 ) -> Vec<usize> {
-    let speed = start.velocity.length();
-    let stopping_m = speed * speed / (2.0 * limits.max_acceleration);
+    let stopping_m = stopping_distance(start, limits);
     let Some((&last, inner)) = kept.split_last() else {
         return Vec::new();
     };
@@ -228,6 +257,13 @@ pub fn plan_global(
     plan_along(grid, start, &path, end_yaw, limits)
 }
 
+/// A fit's trajectory, and how close to its start the fit pinned it.
+struct Fit {
+    trajectory: Result<PiecewisePolynomial, PlanError>,
+    /// Distance from the start to the nearest waypoint the fit added (m; infinite when none).
+    nearest_added_m: f64,
+}
+
 /// The minimum-snap fit through the kept points of `original`, with waypoints added where it
 /// leaves traversable space (module doc).
 fn fit(
@@ -237,7 +273,8 @@ fn fit(
     kept: &[usize],
     end_yaw: Option<f64>,
     limits: &DynamicLimits,
-) -> Result<PiecewisePolynomial, PlanError> {
+) -> Fit {
+    let mut nearest_added_m = f64::INFINITY;
     // Waypoints (the start excluded) and the index in `original` each came from, if any.
     let mut positions: Vec<DVec3> = kept[1..].iter().map(|&i| original[i]).collect();
     let mut origins: Vec<Option<usize>> = kept[1..].iter().map(|&i| Some(i)).collect();
@@ -245,7 +282,7 @@ fn fit(
     // one more).
     let max_insertions = 4 * original.len() + 15;
     let mut added = 0;
-    loop {
+    let trajectory = loop {
         // The heading is fixed at the end only (module doc).
         let end_heading = end_yaw.or_else(|| {
             follow_headings(start.position, start.yaw, &positions)
@@ -260,14 +297,17 @@ fn fit(
                 yaw: end_heading.filter(|_| i + 1 == positions.len()),
             })
             .collect();
-        let trajectory = plan_min_snap(start, &waypoints, limits)?;
+        let trajectory = match plan_min_snap(start, &waypoints, limits) {
+            Ok(trajectory) => trajectory,
+            Err(error) => break Err(error),
+        };
         let Some((time_s, position)) =
             first_untraversable(grid, &trajectory, 0.0, limits.max_velocity)
         else {
-            return Ok(trajectory);
+            break Ok(trajectory);
         };
         if added == max_insertions {
-            return Err(PlanError::StillBlocked {
+            break Err(PlanError::StillBlocked {
                 added,
                 time_s,
                 position,
@@ -286,10 +326,15 @@ fn fit(
         let separated = point.distance(from) >= MIN_POINT_SEPARATION_M
             && point.distance(positions[segment]) >= MIN_POINT_SEPARATION_M;
         if !separated || !grid.is_traversable_point(point) {
-            return Err(PlanError::Collision { time_s, position });
+            break Err(PlanError::Collision { time_s, position });
         }
+        nearest_added_m = nearest_added_m.min(point.distance(start.position));
         positions.insert(segment, point);
         origins.insert(segment, origin);
         added += 1;
+    };
+    Fit {
+        trajectory,
+        nearest_added_m,
     }
 }

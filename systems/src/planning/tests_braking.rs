@@ -124,3 +124,63 @@ fn a_braking_leg_stops_ahead_without_running_past_its_stop() {
     let grid = map.grid(0.27);
     assert!(Braking::of(&grid, &start, &limits).is_none());
 }
+
+/// A UAV 0.8 m from a wall, moving toward it at `speed_scale` times 1.02 m/s and accelerating
+/// toward it at `speed_scale` times 3.3 m/s^2 (scaled from the start of a decision of an EAAE
+/// Pillars mission, seed 2, whose candidates lasted up to 40 times their rest-to-rest time), in
+/// a room with a pillar.
+fn carried_toward_the_wall(speed_scale: f64) -> (TestMap, TrajectoryPoint) {
+    let mut map = open_room();
+    map.fill(IVec3::new(40, 25, 0), IVec3::new(45, 40, 23), OCCUPIED);
+    let start = TrajectoryPoint {
+        position: DVec3::new(2.0, 0.8, 1.2),
+        velocity: speed_scale * DVec3::new(0.56, -0.82, 0.27),
+        acceleration: speed_scale * DVec3::new(1.76, -2.67, 0.92),
+        jerk: DVec3::new(-2.49, 2.75, -0.45),
+        ..TrajectoryPoint::default()
+    };
+    (map, start)
+}
+
+/// Checks a plan from `start` to `goal`: it continues the start, stays traversable within the
+/// limits, ends at the goal, and stops first at the braking leg's stop. Returns its duration
+/// over the rest-to-rest time of the straight line.
+fn stopped_first(
+    grid: &TraversableGrid,
+    start: &TrajectoryPoint,
+    goal: DVec3,
+    plan: &GlobalPlan,
+    limits: &DynamicLimits,
+) -> f64 {
+    assert_safe(grid, &plan.trajectory, limits);
+    let first = plan.trajectory.sample(0.0);
+    assert!(first.velocity.distance(start.velocity) < 1e-9);
+    assert!(first.acceleration.distance(start.acceleration) < 1e-9);
+    assert!(end_of(&plan.trajectory).position.distance(goal) < 1e-9);
+    let braking = Braking::of(grid, start, limits).expect("room to brake");
+    assert_eq!(plan.path[1], braking.stop.position);
+    plan.trajectory.duration() / limits.rest_to_rest_time(start.position.distance(goal))
+}
+
+/// The fit pulls a trajectory carried into the wall back with waypoints from the path, ever
+/// closer to the start; pinned there, the start's motion has to loop, and the time allocation
+/// stretched the whole trajectory (12.9 times the rest-to-rest time), or no allocation held
+/// the limits at all. Stopping first is faster, and is chosen, by the local planner and by a
+/// decision's candidate alike.
+#[test]
+fn a_trajectory_pinned_near_a_moving_start_stops_first_when_that_is_faster() {
+    let limits = kingfisher();
+    for (speed_scale, goal, most) in [
+        (0.8, DVec3::new(8.0, 3.0, 1.2), 1.7),
+        (1.0, DVec3::new(6.0, 1.0, 1.2), 1.75),
+    ] {
+        let (mut map, start) = carried_toward_the_wall(speed_scale);
+        let grid = map.grid(0.27);
+        let path = find_path(&grid, start.position, goal, usize::MAX).unwrap();
+        let local = plan_along(&grid, &start, &path, None, &limits).unwrap();
+        let stretch = stopped_first(&grid, &start, goal, &local, &limits);
+        assert!(stretch < most, "{speed_scale}: {stretch}");
+        let candidate = candidate(&grid, &start, &path, &limits).unwrap();
+        assert_eq!(candidate, local);
+    }
+}

@@ -17,15 +17,17 @@
 //! that must reverse the start's motion within one long segment runs on the way the UAV went.
 //! The local planner does so only when it finds no other trajectory.
 //!
-//! A fit that adds a waypoint closer to a moving start than the start's braking leg stops is
-//! also planned stopping first, and the faster of the two is kept (both planners). Such a
+//! A fit may add waypoints closer to a moving start than the start's braking leg stops. Such a
 //! waypoint pins the polynomial near the start; the start's motion must loop to pass it, and
-//! the time allocation, which scales every segment alike, stretches the whole trajectory. In
-//! the decisions of five EAAE Pillars missions (decision bench) 65 of 7,228 candidates had
-//! lasted more than three times the rest-to-rest time of their paths, up to 40 times; with
-//! stopping first 17 of 7,263 did, at most 5.8 times (docs/performance.md, fifty-second
-//! session). The rest stretch for a reason: a short hop with a half turn of the heading, or a
-//! fast start whose goal lies behind it.
+//! the time allocation, which scales every segment alike, stretches the whole trajectory. A
+//! decision's candidate so pinned is also planned stopping first, and the faster of the two is
+//! kept: in the decisions of five EAAE Pillars missions (decision bench) 65 of 7,228
+//! candidates had lasted more than three times the rest-to-rest time of their paths, up to 40
+//! times; with stopping first 27 of 7,394, at most 5.8 times. The rest stretch for a reason:
+//! a short hop with a half turn of the heading, or a fast start whose goal lies behind it. The
+//! local planner stops first when pinned only if its fit fails: keeping the faster plan there
+//! too, and so braking in flight, made the missions of a forest 4-11 % longer
+//! (docs/performance.md, fifty-second session).
 //!
 //! Headings: the heading turns smoothly from the start's to `end_yaw` (without one, to the
 //! direction of the path's last leg); the waypoints between leave it free, and the time
@@ -60,8 +62,8 @@ pub struct GlobalPlan {
 /// moving) along `path` (e.g. from [`super::find_paths`]; its leading points within 1 cm of
 /// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
 /// direction of the last leg). Waypoints are added until every sample is traversable (module
-/// doc). When no such trajectory is found and the path turns back from the start's motion,
-/// the start stops first ([`super::braking`]). `Err(Collision)` or `Err(StillBlocked)` when
+/// doc). When no such trajectory is found and the path turns back from the start's motion, or
+/// the fit pinned the trajectory near the start, the start stops first ([`super::braking`]). `Err(Collision)` or `Err(StillBlocked)` when
 /// the waypoints do not converge, `Err(NoWaypoints)` when the path does not leave the start.
 ///
 /// The local planner, which replans its flight several times a second, plans this way: it
@@ -76,7 +78,7 @@ pub fn plan_along(
 ) -> Result<GlobalPlan, PlanError> {
     let sees = |a, b| grid.line_of_sight(a, b);
     let braking = BrakingMemo::new();
-    let stop_first = StopFirst::WhenStuckTurningBack;
+    let stop_first = StopFirst::WhenStuck;
     plan_along_by(
         grid, sees, &braking, stop_first, start, path, end_yaw, limits,
     )
@@ -104,13 +106,15 @@ pub fn plan_along_seen(
     )
 }
 
-/// When a start whose path turns back from its motion stops first ([`super::braking`]).
+/// When a moving start stops first ([`super::braking`]): when its path turns back from its
+/// motion, or when the fit pinned the trajectory closer to it than it can stop (module doc).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum StopFirst {
-    /// Always (a decision's candidates: [`plan_along_seen`]).
+    /// Always when the path turns back, and when pinned if that is faster (a decision's
+    /// candidates: [`plan_along_seen`]).
     WhenTurningBack,
     /// Only when no trajectory goes on smoothly (the local planner: [`plan_along`]).
-    WhenStuckTurningBack,
+    WhenStuck,
 }
 
 /// [`plan_along`] with `sees(a, b)` the line of sight of the shortening and the braking leg of
@@ -157,8 +161,11 @@ fn plan_along_by(
             trajectory,
         }
     });
-    // Pinned closer to the start than it can stop: stopping first may be faster (module doc).
-    if let Some(braking) = braking.pinned_within(grid, start, limits, fitted.nearest_added_m) {
+    // A candidate pinned closer to its start than the start can stop: stopping first may be
+    // faster (module doc).
+    if stop_first == StopFirst::WhenTurningBack
+        && let Some(braking) = braking.pinned_within(grid, start, limits, fitted.nearest_added_m)
+    {
         let stopped = stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
         return match (smooth, stopped) {
             (Ok(smooth), Ok(stopped)) => Ok(faster(smooth, stopped)),
@@ -170,15 +177,21 @@ fn plan_along_by(
         Ok(plan) => return Ok(plan),
         Err(error) => error,
     };
-    // Stuck turning back: stop first after all.
-    if stop_first == StopFirst::WhenStuckTurningBack
-        && turns_back
-        && let Some(braking) = braking.get(grid, start, limits)
-    {
-        return stop_then_go(grid, sees, braking, start, original, end_yaw, limits)
-            .map_err(|_| error);
+    if stop_first == StopFirst::WhenTurningBack {
+        return Err(error);
     }
-    Err(error)
+    // Stuck turning back, or pinned near the start: stop first after all.
+    let braking = if turns_back {
+        braking.get(grid, start, limits)
+    } else {
+        braking.pinned_within(grid, start, limits, fitted.nearest_added_m)
+    };
+    match braking {
+        Some(braking) => {
+            stop_then_go(grid, sees, braking, start, original, end_yaw, limits).map_err(|_| error)
+        }
+        None => Err(error),
+    }
 }
 
 /// The shorter in time of two plans (the first on a tie).

@@ -20,8 +20,9 @@
 //! share it ([`BrakingMemo`]).
 //!
 //! The leg's stop also says how near the start a trajectory can be pinned: a waypoint short of
-//! it lies closer than the start can stop, and a fit that adds one is compared with stopping
-//! first ([`BrakingMemo::pinned_within`], [`super::global`]).
+//! it lies closer than the start can stop. A candidate whose fit adds one is compared with
+//! stopping first, and the local planner stops first when such a fit fails
+//! ([`BrakingMemo::pinned_within`], [`super::global`]).
 
 use super::check::first_untraversable;
 use super::traversable::TraversableGrid;

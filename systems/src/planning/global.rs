@@ -63,8 +63,9 @@ pub struct GlobalPlan {
 /// the start are dropped), ending at rest at the path's end with heading `end_yaw` (None: the
 /// direction of the last leg). Waypoints are added until every sample is traversable (module
 /// doc). When no such trajectory is found and the path turns back from the start's motion, or
-/// the fit pinned the trajectory near the start, the start stops first ([`super::braking`]). `Err(Collision)` or `Err(StillBlocked)` when
-/// the waypoints do not converge, `Err(NoWaypoints)` when the path does not leave the start.
+/// the fit pinned the trajectory near the start, the start stops first ([`super::braking`]).
+/// `Err(Collision)` or `Err(StillBlocked)` when the waypoints do not converge,
+/// `Err(NoWaypoints)` when the path does not leave the start.
 ///
 /// The local planner, which replans its flight several times a second, plans this way: it
 /// keeps a smooth continuation wherever there is one (stopping first whenever the path turned

@@ -125,7 +125,7 @@ fn a_braking_leg_stops_ahead_without_running_past_its_stop() {
     assert!(Braking::of(&grid, &start, &limits).is_none());
 }
 
-/// A UAV 0.8 m from a wall, moving toward it at `speed_scale` times 1.02 m/s and accelerating
+/// A UAV 0.8 m from a wall, moving toward it at `speed_scale` times 1.03 m/s and accelerating
 /// toward it at `speed_scale` times 3.3 m/s^2 (scaled from the start of a decision of an EAAE
 /// Pillars mission, seed 2, whose candidates lasted up to 40 times their rest-to-rest time), in
 /// a room with a pillar.

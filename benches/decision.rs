@@ -14,7 +14,8 @@
 //!
 //! It prints p50 / p95 / max per part and of the sum (clustering + trajectories + energy), how
 //! many candidates the time allocation stretched beyond [`STRETCHED`] times the rest-to-rest
-//! time of their paths (the README's known limit of a start accelerating hard), and
+//! time of their paths (see the README's design decision on candidates pinned near a moving
+//! start), and
 //! a digest of every planned candidate (target, viewpoint, trajectory bits), so that a change
 //! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
 //! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.

@@ -162,36 +162,41 @@ fn plan_along_by(
             trajectory,
         }
     });
-    // A candidate pinned closer to its start than the start can stop: stopping first may be
-    // faster (module doc).
-    if stop_first == StopFirst::WhenTurningBack
-        && let Some(braking) = braking.pinned_within(grid, start, limits, fitted.nearest_added_m)
-    {
-        let stopped = stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
-        return match (smooth, stopped) {
-            (Ok(smooth), Ok(stopped)) => Ok(faster(smooth, stopped)),
-            (Ok(plan), Err(_)) | (Err(_), Ok(plan)) => Ok(plan),
-            (Err(error), Err(_)) => Err(error),
-        };
-    }
-    let error = match smooth {
-        Ok(plan) => return Ok(plan),
-        Err(error) => error,
-    };
-    if stop_first == StopFirst::WhenTurningBack {
-        return Err(error);
-    }
-    // Stuck turning back, or pinned near the start: stop first after all.
-    let braking = if turns_back {
-        braking.get(grid, start, limits)
-    } else {
-        braking.pinned_within(grid, start, limits, fitted.nearest_added_m)
-    };
-    match braking {
-        Some(braking) => {
-            stop_then_go(grid, sees, braking, start, original, end_yaw, limits).map_err(|_| error)
+    match stop_first {
+        // A candidate pinned closer to its start than the start can stop: stopping first may
+        // be faster (module doc).
+        StopFirst::WhenTurningBack => {
+            let Some(braking) = braking.pinned_within(grid, start, limits, fitted.nearest_added_m)
+            else {
+                return smooth;
+            };
+            let stopped = stop_then_go(grid, sees, braking, start, original, end_yaw, limits);
+            match (smooth, stopped) {
+                (Ok(smooth), Ok(stopped)) => Ok(faster(smooth, stopped)),
+                (Ok(plan), Err(_)) | (Err(_), Ok(plan)) => Ok(plan),
+                (Err(error), Err(_)) => Err(error),
+            }
         }
-        None => Err(error),
+        // The local planner: stuck turning back, or pinned near the start, it stops first
+        // after all.
+        StopFirst::WhenStuck => {
+            let error = match smooth {
+                Ok(plan) => return Ok(plan),
+                Err(error) => error,
+            };
+            let braking = if turns_back {
+                braking.get(grid, start, limits)
+            } else {
+                braking.pinned_within(grid, start, limits, fitted.nearest_added_m)
+            };
+            match braking {
+                Some(braking) => {
+                    stop_then_go(grid, sees, braking, start, original, end_yaw, limits)
+                        .map_err(|_| error)
+                }
+                None => Err(error),
+            }
+        }
     }
 }
 

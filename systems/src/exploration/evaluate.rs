@@ -162,6 +162,20 @@ pub fn plan_targets(
         .collect()
 }
 
+/// Eaae.md step 7: the predicted energy and duration of every planned candidate, from the
+/// UAV's true state, in parallel; a rollout that fails (an unflyable trajectory) drops it.
+pub fn roll_out_candidates(
+    airframe: &Airframe,
+    start: &FlightState,
+    planned: &[PlannedCandidate],
+    config: &RolloutConfig,
+) -> Vec<Option<RolloutResult>> {
+    planned
+        .par_iter()
+        .map(|candidate| rollout(airframe, start, &candidate.plan.trajectory, config).ok())
+        .collect()
+}
+
 /// The order in which `scope` evaluates `targets` (indices): as given for `All`; for `Ranked`,
 /// by the ranking, ties in the order given (the strategies break ties the same way).
 pub fn evaluation_order(
@@ -279,18 +293,8 @@ pub fn evaluate(
         evaluation.planned += planned.len();
 
         let estimating = Instant::now();
-        let rollouts: Vec<Option<RolloutResult>> = planned
-            .par_iter()
-            .map(|c| {
-                rollout(
-                    inputs.airframe,
-                    &inputs.flight,
-                    &c.plan.trajectory,
-                    &inputs.rollout,
-                )
-                .ok()
-            })
-            .collect();
+        let rollouts =
+            roll_out_candidates(inputs.airframe, &inputs.flight, &planned, &inputs.rollout);
         let returns = inputs.budget.map(|budget| {
             return_energies(
                 inputs.grid,

@@ -9,17 +9,17 @@
 //! (rayon), results in a fixed order so that the decision is the same on any thread count.
 
 use super::budget::ReturnHome;
+pub use super::evaluate::roll_out_candidates;
 use super::evaluate::{
     BudgetCheck, DecisionInputs, Evaluation, TargetPaths, evaluate, plan_targets,
 };
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
-use crate::flight::{Completion, FlightState, RolloutConfig, RolloutResult, rollout};
+use crate::flight::{Completion, FlightState, RolloutConfig};
 use crate::mapping::MapReader;
 use crate::planning::{GlobalPlan, Traversability, TraversableGrid};
 use crate::trajectory::DynamicLimits;
 use bevy_ecs::prelude::*;
 use glam::{DVec3, Vec3};
-use rayon::prelude::*;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{
@@ -68,20 +68,6 @@ pub fn plan_candidates(
     let mut paths = TargetPaths::new(grid, start.position, targets);
     let all: Vec<usize> = (0..targets.len()).collect();
     plan_targets(grid, start, targets, &mut paths, &all, limits, min_travel_m)
-}
-
-/// Eaae.md step 7: the predicted energy and duration of every planned candidate, from the
-/// UAV's true state, in parallel; a rollout that fails (an unflyable trajectory) drops it.
-pub fn roll_out_candidates(
-    airframe: &Airframe,
-    start: &FlightState,
-    planned: &[PlannedCandidate],
-    config: &RolloutConfig,
-) -> Vec<Option<RolloutResult>> {
-    planned
-        .par_iter()
-        .map(|candidate| rollout(airframe, start, &candidate.plan.trajectory, config).ok())
-        .collect()
 }
 
 /// The rollout of a candidate: it ends a flight by the same rule the goal is judged by when

@@ -46,10 +46,10 @@ use uavex_engine::exploration::log::percentile;
 use uavex_engine::scenario::load;
 use uavex_engine::sim::Sim;
 use uavex_systems::exploration::DecideStep;
-use uavex_systems::exploration::evaluate::{TargetGoal, target_goals};
+use uavex_systems::exploration::evaluate::{TargetGoal, roll_out_candidates, target_goals};
 use uavex_systems::exploration::propose::{
     ClusterTarget, PlannedCandidate, cluster_targets, goal_rollout, plan_decision, planning_start,
-    propose_candidates, roll_out_candidates,
+    propose_candidates,
 };
 use uavex_systems::flight::ecs::ReferenceTrajectory;
 use uavex_systems::flight::{FlightState, RolloutConfig};

@@ -9,7 +9,6 @@
 //! (rayon), results in a fixed order so that the decision is the same on any thread count.
 
 use super::budget::ReturnHome;
-pub use super::evaluate::roll_out_candidates;
 use super::evaluate::{
     BudgetCheck, DecisionInputs, Evaluation, TargetPaths, evaluate, plan_targets,
 };

@@ -15,10 +15,10 @@
 //! It prints p50 / p95 / max per part and of the sum (clustering + trajectories + energy), how
 //! many candidates the time allocation stretched beyond [`STRETCHED`] times the rest-to-rest
 //! time of their paths (see the README's design decision on candidates pinned near a moving
-//! start), and
-//! a digest of every planned candidate (target, viewpoint, trajectory bits), so that a change
-//! meant to be a pure speed-up can be checked to plan exactly the same trajectories: set
-//! `DECISION_DIGEST=/some/file` to write one line per decision there and diff two runs.
+//! start), and a digest of every planned candidate (target, viewpoint, trajectory bits), so
+//! that a change meant to be a pure speed-up can be checked to plan exactly the same
+//! trajectories: set `DECISION_DIGEST=/some/file` to write one line per decision there and diff
+//! two runs.
 //! `DECISION_SEEDS=1,2` picks the seeds (default 1); `DECISION_TOP=n` lists the n slowest
 //! decisions with their parts; `DECISION_EXPLAIN=k` lists every plan decision `k` tries, with
 //! its outcome and time; `DECISION_LOOPS=n` replays the planning

@@ -39,6 +39,10 @@ pub struct ExplorerSettings {
     pub unified: bool,
     /// Energy budget (beyond the thesis): `None` flies until the battery is empty.
     pub budget: Option<EnergyBudget>,
+    /// When a goal is reached, the frontier voxels within this distance of the UAV (the space
+    /// its camera has just seen: the sensor's range) are searched for the insides of obstacles
+    /// behind them (`uavex_systems::exploration::interior`).
+    pub interior_search_m: f32,
 }
 
 impl ExplorerSettings {
@@ -55,6 +59,7 @@ impl ExplorerSettings {
             vanished_fraction: 0.2,
             unified: false,
             budget: None,
+            interior_search_m: range_max_m as f32,
         }
     }
 }

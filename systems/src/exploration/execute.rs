@@ -11,11 +11,12 @@
 //!
 //! Frontier that a reached goal could not clear (a sliver no viewpoint sees) would attract the
 //! UAV forever: a voxel still frontier after a second reached goal covering it is ignored from
-//! then on ([`VisitedFrontier`]); so is at once, when a goal is reached, a frontier voxel that
-//! is one only because it borders the inside of an obstacle ([`super::interior`]).
+//! then on ([`VisitedFrontier`]); so is at once, when a goal is reached, a frontier voxel of
+//! the goal or within the sensor's range that is one only because it borders the inside of an
+//! obstacle ([`super::interior`]).
 
 use super::commit::{DecisionBackoff, energy_drawn};
-use super::interior::around_interiors;
+use super::interior::{around_interiors, frontier_near};
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
 use crate::mapping::MapReader;
 use crate::planning::{
@@ -205,7 +206,15 @@ pub fn fly_to_goals(
                             frontier.ignore(key);
                         }
                     }
-                    for key in around_interiors(&map, &left) {
+                    // The goal's own frontier first, then the rest in sight, nearest first.
+                    let mut search = left;
+                    search.extend(frontier_near(
+                        &frontier,
+                        map.config.resolution() as f32,
+                        state.position,
+                        settings.interior_search_m,
+                    ));
+                    for key in around_interiors(&map, &search) {
                         frontier.ignore(key);
                     }
                     entity.insert(NeedsDecision);

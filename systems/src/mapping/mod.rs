@@ -42,7 +42,7 @@ pub mod update;
 mod walk;
 
 pub use integrate::{ChunkAccess, ScanError, ScanRays, integrate_scan, integrate_scan_tallied};
-pub use read::{GroundTruth, MapReader, OccupancyMap, WorldVoxels, map_accuracy};
+pub use read::{GroundTruth, MapReader, NearbyStates, OccupancyMap, WorldVoxels, map_accuracy};
 pub use report::ScanReport;
 pub use state_changes::{StateChange, StateChanges};
 pub use store::ChunkStore;

@@ -62,6 +62,38 @@ pub trait OccupancyMap {
     }
 }
 
+/// Voxel states read one after another close together (a flood fill): the chunk of the last
+/// voxel read is kept, so a voxel in the same chunk, most of them, costs no chunk lookup
+/// (through [`MapReader`] a lookup is an entity query, several times the rest of the read).
+pub struct NearbyStates<'m, M> {
+    map: &'m M,
+    last: Option<(ChunkCoord, Option<&'m VoxelChunk>)>,
+}
+
+impl<'m, M: OccupancyMap> NearbyStates<'m, M> {
+    pub fn new(map: &'m M) -> Self {
+        Self { map, last: None }
+    }
+
+    /// The state of voxel `key` ([`OccupancyMap::state`]), `None` outside the map.
+    #[inline]
+    pub fn state(&mut self, key: IVec3) -> Option<VoxelState> {
+        if !self.map.config().contains_key(key) {
+            return None;
+        }
+        let coord = ChunkCoord::of_key(key);
+        let chunk = match self.last {
+            Some((last, chunk)) if last == coord => chunk,
+            _ => {
+                let chunk = self.map.chunk(coord);
+                self.last = Some((coord, chunk));
+                chunk
+            }
+        };
+        Some(chunk.map_or(VoxelState::Unknown, |chunk| chunk.state(local_index(key))))
+    }
+}
+
 /// The truth a map is measured against ([`map_accuracy`]): any `Fn(IVec3) -> bool` telling
 /// whether a voxel key is occupied, or [`WorldVoxels`].
 pub trait GroundTruth {

@@ -175,10 +175,16 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
 #[test]
 fn a_forest_of_round_trunks_is_explored_to_the_end() {
     let path = format!("{}/scenarios/eaae_forest.toml", env!("CARGO_MANIFEST_DIR"));
-    let mut loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
+    let loaded = load(&path).unwrap_or_else(|e| panic!("{e}"));
     // The limit the mission without the rule ran to (the shipped scene allows 600 s).
-    loaded.scenario.time_limit_s = 400.0;
-    let summary = run_seed(&loaded, 2);
+    assert_forest_complete_within(loaded, 2, 400.0);
+}
+
+/// Runs `loaded` (a forest) on `seed` with the time limit `limit_s`: it must end `complete`
+/// before it, at >= 99 % of the reachable volume.
+fn assert_forest_complete_within(mut loaded: LoadedScenario, seed: u64, limit_s: f64) {
+    loaded.scenario.time_limit_s = limit_s;
+    let summary = run_seed(&loaded, seed);
     let reachable = summary
         .exploration
         .as_ref()
@@ -190,7 +196,7 @@ fn a_forest_of_round_trunks_is_explored_to_the_end() {
         "{} ({reachable:.3} % explored)",
         summary.reason
     );
-    assert!(summary.mission_time_s < loaded.scenario.time_limit_s);
+    assert!(summary.mission_time_s < limit_s);
     assert!(reachable >= 99.0, "{reachable}");
 }
 
@@ -201,21 +207,8 @@ fn a_forest_of_round_trunks_is_explored_to_the_end() {
 #[test]
 fn slivers_around_trunks_in_sight_draw_no_flight() {
     // The shipped forest, flown by Classic (the scene's behaviour but for the strategy).
-    let mut loaded = scene("eaae_forest.toml", StrategyName::Classic);
-    loaded.scenario.time_limit_s = 450.0;
-    let summary = run_seed(&loaded, 36);
-    let reachable = summary
-        .exploration
-        .as_ref()
-        .and_then(|keys| keys.explored_reachable_pct)
-        .expect("an exploration run floods its reachable volume");
-    assert_eq!(
-        summary.outcome,
-        Outcome::Complete,
-        "{} ({reachable:.3} % explored)",
-        summary.reason
-    );
-    assert!(reachable >= 99.0, "{reachable}");
+    let loaded = scene("eaae_forest.toml", StrategyName::Classic);
+    assert_forest_complete_within(loaded, 36, 450.0);
 }
 
 /// A seeded forest keeps the explorer's start capsule clear by itself. Seeds that drew a trunk

@@ -404,6 +404,10 @@ mod tests {
         assert_eq!(inside.voxels.len(), 160);
     }
 
+    fn random_key(rng: &mut ChaCha8Rng, range: std::ops::Range<i32>) -> IVec3 {
+        IVec3::from_array(std::array::from_fn(|_| rng.random_range(range.clone())))
+    }
+
     #[test]
     fn key_bits_hold_what_a_hash_set_holds() {
         let mut rng = ChaCha8Rng::seed_from_u64(3);
@@ -411,11 +415,7 @@ mod tests {
         let mut reference = HashSet::new();
         for _ in 0..20_000 {
             // Keys across chunk borders on both sides of zero, many of them repeated.
-            let key = IVec3::new(
-                rng.random_range(-40..40),
-                rng.random_range(-40..40),
-                rng.random_range(-40..40),
-            );
+            let key = random_key(&mut rng, -40..40);
             if rng.random_bool(0.5) {
                 assert_eq!(bits.insert(key), reference.insert(key), "{key}");
             } else {
@@ -430,13 +430,8 @@ mod tests {
         let mut store = ChunkStore::new(&config());
         let mut rng = ChaCha8Rng::seed_from_u64(5);
         let states = [VoxelState::Unknown, VoxelState::Free, VoxelState::Occupied];
-        let keys = |rng: &mut ChaCha8Rng| {
-            IVec3::new(
-                rng.random_range(-36..34),
-                rng.random_range(-36..34),
-                rng.random_range(-36..34),
-            )
-        };
+        // Keys of the map (-32..=29 on each axis) and a few outside it.
+        let keys = |rng: &mut ChaCha8Rng| random_key(rng, -36..34);
         for _ in 0..5_000 {
             let key = keys(&mut rng);
             if store.config().contains_key(key) {

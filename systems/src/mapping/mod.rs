@@ -15,7 +15,8 @@
 //! - `walk`: the walk proper, voxel by voxel in a chunk, past the saturated cubes it meets.
 //! - [`report`]: [`ScanReport`], what an integration did (and, asked for, how it skipped).
 //! - [`store`]: [`ChunkStore`], a map outside the ECS (tests, benchmarks, tools).
-//! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, map accuracy.
+//! - [`read`]: [`OccupancyMap`] queries, the [`MapReader`] system parameter, [`NearbyStates`]
+//!   (states read chunk by chunk, for floods), map accuracy.
 //! - [`state_changes`]: [`StateChanges`], the chunks whose voxel states changed (for consumers
 //!   that depend on states alone: frontiers, traversability).
 //! - [`system`]: the ECS system [`integrate_scans`] and [`insert_map_resources`].

@@ -9,7 +9,9 @@ mod common;
 use bevy_ecs::prelude::*;
 use bevy_ecs::system::SystemState;
 use std::collections::BTreeSet;
-use uavex::components::exploration::{CandidateScope, Chosen, DecisionLog, GoalKind, GoalOutcome};
+use uavex::components::exploration::{
+    CandidateRecord, CandidateScope, Chosen, DecisionLog, GoalKind, GoalOutcome,
+};
 use uavex::components::map::MapConfig;
 use uavex::components::sim::Outcome;
 use uavex::components::world::WorldGeometry;
@@ -40,6 +42,7 @@ fn scene(file: &str, strategy: StrategyName) -> LoadedScenario {
         unified: false,
         replan_hz: 2.0,
         energy_budget: None,
+        standoff_m: None,
     });
     loaded
 }
@@ -151,6 +154,19 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
         }
     }
     // The reachable volume excludes the room, and nearly all of it was seen.
+    let (volume, explored) = reachable_explored(&mut sim);
+    let room_centre = sim
+        .world
+        .resource::<MapConfig>()
+        .key_of(glam::Vec3::new(6.0, -6.0, 1.0))
+        .unwrap();
+    assert!(!volume.contains(room_centre));
+    assert!(explored >= 95.0, "{explored}");
+}
+
+/// The volume reachable from the start (0, 0, 1) of a run that ended, and the share of it
+/// its map explored (%).
+fn reachable_explored(sim: &mut Sim) -> (ReachableVolume, f64) {
     let world = &mut sim.world;
     let volume = ReachableVolume::flood(
         world.resource::<MapConfig>(),
@@ -158,13 +174,57 @@ fn a_closed_room_is_not_entered_and_the_run_completes() {
         glam::Vec3::new(0.0, 0.0, 1.0),
     )
     .unwrap();
-    let room_centre = world
-        .resource::<MapConfig>()
-        .key_of(glam::Vec3::new(6.0, -6.0, 1.0))
-        .unwrap();
-    assert!(!volume.contains(room_centre));
     let mut reader = SystemState::<MapReader>::new(world);
     let explored = volume.explored_pct(&reader.get(world).unwrap());
+    (volume, explored)
+}
+
+/// With the standoff option (beyond the thesis) a goal is a viewpoint 2.5 m from its
+/// cluster's centroid, level with it, unless no viewpoint had a feasible trajectory (then the
+/// centroid, as eaae.md step 6 plans); the mission still explores Pillars to the end.
+#[test]
+fn standoff_goals_view_their_clusters_from_a_distance() {
+    let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);
+    if let BehaviourSpec::Explore(explore) = &mut loaded.scenario.uavs[0].behaviour {
+        explore.standoff_m = Some(2.5);
+    }
+    let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
+    let (outcome, reason) = sim.run_to_end();
+    assert_eq!(outcome, Outcome::Complete, "{reason}");
+    let log = sim.world.resource::<DecisionLog>();
+    let goals: Vec<_> = log
+        .decisions
+        .iter()
+        .filter_map(|d| d.chosen.map(|i| &d.candidates[i]))
+        .collect();
+    let off = |c: &&CandidateRecord| {
+        let [gx, gy, gz] = c.goal;
+        let [cx, cy, cz] = c.centroid;
+        ((gx - cx).hypot(gy - cy), (gz - cz).abs())
+    };
+    // A goal the planner could not reach exactly ends at the nearest traversable point (a
+    // centroid near the floor, say), within a voxel layer or a few of it.
+    let exactly_at_standoff = goals
+        .iter()
+        .filter(|c| {
+            let (horizontal, vertical) = off(c);
+            (horizontal - 2.5).abs() < 1e-3 && vertical < 1e-3
+        })
+        .count();
+    let near_standoff_or_centroid = goals
+        .iter()
+        .filter(|c| {
+            let (horizontal, vertical) = off(c);
+            (horizontal - 2.5).abs() < 0.5 || horizontal.hypot(vertical) < 1.0
+        })
+        .count();
+    assert_eq!(near_standoff_or_centroid, goals.len());
+    assert!(
+        goals.len() >= 20 && exactly_at_standoff * 4 >= goals.len() * 3,
+        "{exactly_at_standoff} of {} goals at the standoff",
+        goals.len()
+    );
+    let (_, explored) = reachable_explored(&mut sim);
     assert!(explored >= 95.0, "{explored}");
 }
 
@@ -449,8 +509,11 @@ fn unified_mode_flies_what_it_predicted() {
 
 /// The runs of the shipped sweep plan `file`, each checked to be a valid exploration of the
 /// strategy (and, where the grid sets it, the candidate count) its grid values name, without
-/// map export: (scene, grid values, seed) of each.
-fn shipped_exploration_plan(file: &str) -> BTreeSet<(String, String, u64)> {
+/// map export, and to satisfy `check`: (scene, grid values, seed) of each.
+fn shipped_exploration_plan(
+    file: &str,
+    check: impl Fn(&ExploreSpec),
+) -> BTreeSet<(String, String, u64)> {
     use uavex::engine::scenario::parse_str;
     use uavex::engine::sweep::{Plan, apply_overrides, expand};
     let path = format!("{}/scenarios/{file}", env!("CARGO_MANIFEST_DIR"));
@@ -473,6 +536,7 @@ fn shipped_exploration_plan(file: &str) -> BTreeSet<(String, String, u64)> {
             assert_eq!(set.unwrap(), named, "{}: {field}", run.id);
         }
         assert!(!loaded.scenario.outputs.export_map);
+        check(explore);
         let values: Vec<String> = run.coordinates.iter().map(|(_, v)| v.to_string()).collect();
         seen.insert((run.scene.clone(), values.join(", "), run.seed));
     }
@@ -482,12 +546,29 @@ fn shipped_exploration_plan(file: &str) -> BTreeSet<(String, String, u64)> {
 /// The shipped protocol plan: 2 scenes x 3 strategies x 5 seeds.
 #[test]
 fn the_protocol_plan_runs_every_strategy_on_both_scenes() {
-    assert_eq!(shipped_exploration_plan("eaae_protocol.toml").len(), 30);
+    let thesis_goals = |explore: &ExploreSpec| assert_eq!(explore.standoff_m, None);
+    assert_eq!(
+        shipped_exploration_plan("eaae_protocol.toml", thesis_goals).len(),
+        30
+    );
+}
+
+/// The shipped protocol with the standoff option: the same 30 runs, each with the option set.
+#[test]
+fn the_standoff_plan_runs_the_protocol_with_the_standoff() {
+    let standoff = |explore: &ExploreSpec| assert_eq!(explore.standoff_m, Some(2.5));
+    assert_eq!(
+        shipped_exploration_plan("standoff_comparison.toml", standoff),
+        shipped_exploration_plan("eaae_protocol.toml", |_| {})
+    );
 }
 
 /// The shipped comparison of EAAE's choice with the tour: 2 scenes x 2 strategies x 2
 /// candidate counts x 5 seeds.
 #[test]
 fn the_tour_comparison_plan_runs_both_strategies_both_ways() {
-    assert_eq!(shipped_exploration_plan("tour_comparison.toml").len(), 40);
+    assert_eq!(
+        shipped_exploration_plan("tour_comparison.toml", |_| {}).len(),
+        40
+    );
 }

@@ -43,6 +43,11 @@ pub struct ExplorerSettings {
     /// its camera has just seen: the sensor's range) are searched for the insides of obstacles
     /// behind them (`uavex_systems::exploration::interior`).
     pub interior_search_m: f32,
+    /// Beyond the thesis: fly to a viewpoint this far from a cluster's centroid, level with
+    /// it and facing it, before trying the centroid (`None`: the thesis' centroid first, then
+    /// its viewpoints 0.5 m off; eaae.md step 6). See
+    /// `uavex_systems::frontier::standoff_viewpoints`.
+    pub standoff_m: Option<f32>,
 }
 
 impl ExplorerSettings {
@@ -60,6 +65,7 @@ impl ExplorerSettings {
             unified: false,
             budget: None,
             interior_search_m: range_max_m as f32,
+            standoff_m: None,
         }
     }
 }

@@ -203,6 +203,7 @@ pub fn explorer_components(
     settings.budget = explore.energy_budget.map(|b| EnergyBudget {
         reserve_j: b.reserve_j,
     });
+    settings.standoff_m = explore.standoff_m.map(|d| d as f32);
     let explorer = Explorer {
         settings,
         home: start.as_vec3(),

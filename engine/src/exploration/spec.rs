@@ -14,6 +14,9 @@
 //! unified = false            # fly the evaluated candidate itself while it stays free
 //! replan_hz = 2.0            # local planner's regular replanning rate
 //! energy_budget = { reserve_j = 5000.0 }   # optional: return home before the battery runs low
+//! standoff_m = 2.5           # optional, beyond the thesis: fly to a viewpoint this far from
+//!                            # a cluster's centroid, level with it and facing it, before
+//!                            # trying the centroid (absent: the thesis' centroid first)
 //! ```
 //! Everything but `strategy` has the default shown.
 
@@ -94,6 +97,10 @@ pub struct ExploreSpec {
     pub replan_hz: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub energy_budget: Option<BudgetSpec>,
+    /// Distance (m) of the standoff viewpoints (`ExplorerSettings::standoff_m`); `None`: the
+    /// thesis' goals.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub standoff_m: Option<f64>,
 }
 
 fn default_candidates() -> CandidateCount {

@@ -36,7 +36,8 @@ pub struct TargetGoal {
 }
 
 /// A target's goals in the order a decision tries them (eaae.md step 6: the centroid first,
-/// then the viewpoints), the order of the goals of [`TargetPaths`].
+/// then the viewpoints; with the standoff option the viewpoints first), the order of the goals
+/// of [`TargetPaths`].
 pub fn target_goals(target: &ClusterTarget) -> impl Iterator<Item = TargetGoal> + '_ {
     let centroid = TargetGoal {
         position: target.centroid.as_dvec3(),
@@ -52,7 +53,9 @@ pub fn target_goals(target: &ClusterTarget) -> impl Iterator<Item = TargetGoal> 
             viewpoint: Some(i),
             yaw: Some(f64::from(v.yaw)),
         });
-    std::iter::once(centroid).chain(viewpoints)
+    let first = target.centroid_first.then_some(centroid);
+    let last = (!target.centroid_first).then_some(centroid);
+    first.into_iter().chain(viewpoints).chain(last)
 }
 
 /// The paths of one multi-goal search from the UAV to the targets' centroids and viewpoints,
@@ -332,6 +335,7 @@ fn elapsed_ms(since: Instant) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::exploration::propose::with_standoff;
     use crate::exploration::strategy::classic::largest_gain;
     use crate::exploration::strategy::eaae::least_energy_among_largest_gain;
     use crate::exploration::strategy::nearest::nearest;
@@ -397,6 +401,7 @@ mod tests {
                 centroid: Vec3::from_array(c),
                 size,
                 viewpoints: Vec::new(),
+                centroid_first: true,
             })
             .collect()
     }
@@ -420,24 +425,72 @@ mod tests {
             .collect()
     }
 
+    /// A decision's inputs for a kingfisher at rest at `position` (heading 0), no budget.
+    fn inputs_at_rest<'a>(
+        grid: &'a TraversableGrid,
+        airframe: &'a Airframe,
+        position: DVec3,
+    ) -> DecisionInputs<'a> {
+        let start = TrajectoryPoint::at_rest(position, 0.0);
+        DecisionInputs {
+            grid,
+            start,
+            flight: FlightState::hovering(airframe, position, 0.0),
+            airframe,
+            limits: DynamicLimits::of(airframe),
+            rollout: RolloutConfig::default(),
+            min_travel_m: 0.3,
+            budget: None,
+        }
+    }
+
+    /// With the standoff option a decision plans to a viewpoint at the standoff distance,
+    /// level with the centroid and facing it, not to the centroid; without it, to the
+    /// centroid whenever that is feasible.
+    #[test]
+    fn standoff_targets_are_planned_to_their_viewpoints_first() {
+        let (_, store, grid) = room();
+        let airframe = Airframe::kingfisher();
+        let inputs = inputs_at_rest(&grid, &airframe, DVec3::new(1.5, 1.5, 0.8));
+        let at = inputs.start.position.as_vec3();
+        let thesis = targets();
+        let standoff = with_standoff(&thesis, &store, 1.5, 0.25, at);
+        let centroid_goals = evaluate(&inputs, &thesis, at, CandidateScope::All).candidates;
+        assert!(!centroid_goals.is_empty());
+        assert!(
+            centroid_goals
+                .iter()
+                .all(|c| c.candidate.viewpoint.is_none()),
+            "every centroid of the room is feasible"
+        );
+        let viewpoint_goals = evaluate(&inputs, &standoff, at, CandidateScope::All).candidates;
+        assert_eq!(viewpoint_goals.len(), centroid_goals.len());
+        for evaluated in &viewpoint_goals {
+            let candidate = &evaluated.candidate;
+            let target = &standoff[candidate.target];
+            let viewpoint = candidate.viewpoint.expect("a standoff viewpoint");
+            assert_eq!(
+                candidate.goal.as_vec3(),
+                target.viewpoints[viewpoint].position
+            );
+            let to_centroid = target.centroid.as_dvec3() - candidate.goal;
+            assert!(
+                (to_centroid.length() - 1.5).abs() < 1e-5 && to_centroid.z.abs() < 1e-9,
+                "{to_centroid:?}"
+            );
+            let facing = DVec3::new(candidate.goal_yaw.cos(), candidate.goal_yaw.sin(), 0.0);
+            assert!(facing.dot(to_centroid.normalize()) > 1.0 - 1e-5);
+        }
+    }
+
     /// Each shipped strategy picks the same cluster from its ranked evaluation as from the
     /// evaluation of every cluster, with fewer clusters evaluated.
     #[test]
     fn ranked_evaluation_picks_what_evaluating_all_would() {
         let (_, _, grid) = room();
         let airframe = Airframe::kingfisher();
-        let start = TrajectoryPoint::at_rest(DVec3::new(1.5, 1.5, 0.8), 0.0);
-        let at = start.position.as_vec3();
-        let inputs = DecisionInputs {
-            grid: &grid,
-            start,
-            flight: FlightState::hovering(&airframe, start.position, 0.0),
-            airframe: &airframe,
-            limits: DynamicLimits::of(&airframe),
-            rollout: RolloutConfig::default(),
-            min_travel_m: 0.3,
-            budget: None,
-        };
+        let inputs = inputs_at_rest(&grid, &airframe, DVec3::new(1.5, 1.5, 0.8));
+        let (start, at) = (inputs.start, inputs.start.position.as_vec3());
         let targets = targets();
         let all = evaluate(&inputs, &targets, at, CandidateScope::All);
         assert_eq!(all.candidates.len(), 6, "all but the cluster in the pocket");

@@ -5,7 +5,8 @@
 //! The published system planned each of its three candidates with its own kinodynamic search
 //! (1.9-3.3 s per decision). Here one multi-goal search from the UAV reaches every cluster's
 //! centroid and viewpoints at once; each cluster then gets its minimum-snap trajectory (centroid
-//! first, then viewpoints in turn, eaae.md step 6) and its rollout, clusters in parallel
+//! first, then viewpoints in turn, eaae.md step 6; viewpoints first with the standoff option,
+//! [`with_standoff`]) and its rollout, clusters in parallel
 //! (rayon), results in a fixed order so that the decision is the same on any thread count.
 
 use super::budget::ReturnHome;
@@ -14,7 +15,8 @@ use super::evaluate::{
 };
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
 use crate::flight::{Completion, FlightState, RolloutConfig};
-use crate::mapping::MapReader;
+use crate::frontier::standoff_viewpoints;
+use crate::mapping::{MapReader, OccupancyMap};
 use crate::planning::{GlobalPlan, Traversability, TraversableGrid};
 use crate::trajectory::DynamicLimits;
 use bevy_ecs::prelude::*;
@@ -25,7 +27,9 @@ use uavex_components::exploration::{
     CandidateScope, CandidateTrajectory, DecisionTiming, Explorer, ExplorerSettings, For,
     NeedsDecision, PredictedDuration, PredictedEnergy, Toward, Unaffordable,
 };
-use uavex_components::frontier::{FrontierCluster, Reachable, Viewpoint, Viewpoints};
+use uavex_components::frontier::{
+    ClusterSettings, FrontierCluster, Reachable, Viewpoint, Viewpoints,
+};
 use uavex_components::sim::SimClock;
 use uavex_components::trajectory::TrajectoryPoint;
 use uavex_components::uav::QuadState;
@@ -41,6 +45,9 @@ pub struct ClusterTarget {
     pub centroid: Vec3,
     pub size: u32,
     pub viewpoints: Vec<Viewpoint>,
+    /// Whether a decision plans toward the centroid before the viewpoints (eaae.md step 6)
+    /// or after them (the standoff option: `ExplorerSettings::standoff_m`).
+    pub centroid_first: bool,
 }
 
 /// A cluster with a feasible trajectory toward it.
@@ -144,6 +151,7 @@ pub fn cluster_targets(
             centroid: cluster.centroid,
             size: cluster.size,
             viewpoints: viewpoints.0.clone(),
+            centroid_first: true,
         })
         .collect();
     all.sort_by(|a, b| {
@@ -154,6 +162,26 @@ pub fn cluster_targets(
             .then(a.size.cmp(&b.size))
     });
     all
+}
+
+/// `targets` as a UAV with the standoff option plans them: each cluster's viewpoints
+/// `distance` from its centroid ([`standoff_viewpoints`], nearest to `from` first) in place
+/// of the thesis' and tried before the centroid.
+pub fn with_standoff(
+    targets: &[ClusterTarget],
+    map: &impl OccupancyMap,
+    distance: f32,
+    clearance: f32,
+    from: Vec3,
+) -> Vec<ClusterTarget> {
+    targets
+        .iter()
+        .map(|target| ClusterTarget {
+            viewpoints: standoff_viewpoints(map, target.centroid, distance, clearance, from),
+            centroid_first: false,
+            ..target.clone()
+        })
+        .collect()
 }
 
 /// Candidates of this decision, for the commit (how many clusters it saw, its timings, the
@@ -185,6 +213,7 @@ pub fn propose_candidates(
         With<NeedsDecision>,
     >,
     clusters: Query<(Entity, &FrontierCluster, &Viewpoints), With<Reachable>>,
+    cluster_settings: Res<ClusterSettings>,
 ) {
     if uavs.is_empty() {
         return;
@@ -215,7 +244,16 @@ pub fn propose_candidates(
         };
         let scope = scope.copied().unwrap_or_default();
 
-        let (far, near) = split_too_close(&all, state.position, settings.min_goal_distance_m);
+        let standoff;
+        let clusters = match settings.standoff_m {
+            None => &all,
+            Some(distance) => {
+                let clearance = cluster_settings.viewpoint_clearance_m;
+                standoff = with_standoff(&all, &map, distance, clearance, state.position);
+                &standoff
+            }
+        };
+        let (far, near) = split_too_close(clusters, state.position, settings.min_goal_distance_m);
         let mut evaluation = evaluate(&inputs, &far, state.position, scope);
         let mut targets = far;
         if evaluation.planned == 0 && !near.is_empty() {

@@ -1,6 +1,7 @@
 //! Cluster filtering and viewpoints (eaae.md steps 3 and 4).
 
 use super::super::mapping::OccupancyMap;
+use super::super::mapping::dda::all_keys;
 use glam::{IVec3, Vec3, Vec3Swizzles};
 use uavex_components::frontier::{ClusterSettings, Viewpoint};
 use uavex_components::map::{MapConfig, VoxelState};
@@ -87,6 +88,54 @@ pub fn is_clear(map: &impl OccupancyMap, position: Vec3, clearance: f32) -> bool
         }
     }
     true
+}
+
+/// Directions of the standoff viewpoints around a centroid: every 45 degrees in the x-y plane.
+const STANDOFF_DIRECTIONS: usize = 8;
+
+/// Viewpoints `distance` from the centroid in the x-y plane, at its height, every 45 degrees,
+/// each kept if [`is_clear`] with `clearance` and no known-occupied voxel lies between it and
+/// the centroid ([`in_sight`]), facing the centroid, nearest to `from` first (the standoff
+/// option, beyond the thesis: `ExplorerSettings::standoff_m`).
+///
+/// Why level with the centroid and at a distance: the camera looks forward with a vertical
+/// field of view of +-0.39 rad and sees nothing nearer than its minimum range, so a UAV at the
+/// centroid sees little of a cluster that spans `r_max` around it (the frontier above, below
+/// and beside it), and comes back for it later; from a few metres off it has the cluster in
+/// its frustum.
+pub fn standoff_viewpoints(
+    map: &impl OccupancyMap,
+    centroid: Vec3,
+    distance: f32,
+    clearance: f32,
+    from: Vec3,
+) -> Vec<Viewpoint> {
+    let mut viewpoints: Vec<(f32, Viewpoint)> = (0..STANDOFF_DIRECTIONS)
+        .filter_map(|i| {
+            let bearing = std::f32::consts::TAU * i as f32 / STANDOFF_DIRECTIONS as f32;
+            let (sin, cos) = bearing.sin_cos();
+            let position = centroid + Vec3::new(cos, sin, 0.0) * distance;
+            let useful = is_clear(map, position, clearance) && in_sight(map, position, centroid);
+            useful.then(|| {
+                // Facing back along the bearing: toward the centroid.
+                let yaw = (-sin).atan2(-cos);
+                (position.distance(from), Viewpoint { position, yaw })
+            })
+        })
+        .collect();
+    // Stable: viewpoints as far from `from` stay in bearing order.
+    viewpoints.sort_by(|a, b| a.0.total_cmp(&b.0));
+    viewpoints.into_iter().map(|(_, v)| v).collect()
+}
+
+/// Whether no known-occupied voxel lies on the segment from `a` to `b` (the voxel traversal
+/// of `crate::mapping::dda`); unknown voxels do not block it: a camera there sees into them.
+pub fn in_sight(map: &impl OccupancyMap, a: Vec3, b: Vec3) -> bool {
+    let config = map.config();
+    let (ua, ub) = (config.to_voxel_units(a), config.to_voxel_units(b));
+    all_keys(ua, ub, config.key_min(), config.key_max(), |key| {
+        map.state(key) != VoxelState::Occupied
+    })
 }
 
 /// EAAE step 4: the centroid offset by `viewpoint_offset_m` along +x, -x, +y, -y, +z, -z (in

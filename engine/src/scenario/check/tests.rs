@@ -237,6 +237,25 @@ fn uav_settings() {
     );
 }
 
+#[test]
+fn explore_settings() {
+    let explore = |settings: &str| {
+        with(
+            "kind = \"scripted\"\nspeed = 1.0\nwaypoints = [[5.0, 5.0, 1.0]]",
+            &format!("kind = \"explore\"\nstrategy = \"eaae\"\n{settings}"),
+        )
+    };
+    assert_eq!(findings(&explore("standoff_m = 2.5")), vec![]);
+    assert_eq!(
+        one(&explore("standoff_m = 0.0")),
+        finding("uav[0].behaviour.standoff_m", "must be above 0", "0.0")
+    );
+    assert_eq!(
+        one(&explore("candidates = 0")),
+        finding("uav[0].behaviour.candidates", "must be at least 1", "0")
+    );
+}
+
 /// The scenario with bounds reaching 5 m below the floor and `from` replaced by `to`: a
 /// position there passes the bounds check, and below the ground slab (1 m thick) no obstacle
 /// check sees it either. Asserts that `path` is refused as under the ground with `value`, and

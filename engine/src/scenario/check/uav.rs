@@ -160,6 +160,9 @@ fn check_behaviour(
         }
         BehaviourSpec::Explore(explore) => {
             positive(out, path.key("replan_hz"), explore.replan_hz);
+            if let Some(standoff) = explore.standoff_m {
+                positive(out, path.key("standoff_m"), standoff);
+            }
             if let CandidateCount::Count(n) = explore.candidates {
                 at_least_one(out, path.key("candidates"), n);
             }

@@ -194,3 +194,68 @@ fn matching_keeps_the_nearest_old_cluster_within_half_r_max() {
         vec![None]
     );
 }
+
+#[test]
+fn standoff_viewpoints_face_the_centroid_from_their_distance_nearest_first() {
+    let mut store = ChunkStore::new(&config());
+    for x in -25..=25 {
+        for y in -25..=25 {
+            set(&mut store, IVec3::new(x, y, 10), VoxelState::Free);
+        }
+    }
+    // The UAV west of the centroid.
+    let from = CENTROID - Vec3::new(5.0, 0.0, 0.0);
+    let vps = standoff_viewpoints(&store, CENTROID, 2.0, 0.0, from);
+    assert_eq!(vps.len(), 8, "{vps:?}");
+    // The nearest first: due west, facing east.
+    assert!(
+        close(vps[0].position, Vec3::new(-1.95, 0.05, 1.05)),
+        "{vps:?}"
+    );
+    assert!(vps[0].yaw.abs() < 1e-6, "{vps:?}");
+    for pair in vps.windows(2) {
+        assert!(pair[0].position.distance(from) <= pair[1].position.distance(from));
+    }
+    for vp in &vps {
+        let to_centroid = CENTROID - vp.position;
+        assert_eq!(to_centroid.z, 0.0, "level with the centroid: {vp:?}");
+        assert!((to_centroid.length() - 2.0).abs() < 1e-5, "{vp:?}");
+        let facing = Vec3::new(vp.yaw.cos(), vp.yaw.sin(), 0.0);
+        assert!(facing.dot(to_centroid.normalize()) > 1.0 - 1e-5, "{vp:?}");
+    }
+    // Equally far from the UAV: kept in bearing order (135 degrees before 225).
+    assert!(
+        vps[1].position.y > CENTROID.y && vps[2].position.y < CENTROID.y,
+        "{vps:?}"
+    );
+
+    // An occupied voxel at the eastern viewpoint drops it alone.
+    set(&mut store, IVec3::new(20, 0, 10), VoxelState::Occupied);
+    let vps = standoff_viewpoints(&store, CENTROID, 2.0, 0.0, from);
+    assert_eq!(vps.len(), 7, "{vps:?}");
+    assert!(vps.iter().all(|v| v.position.x < 2.0), "{vps:?}");
+}
+
+#[test]
+fn a_standoff_viewpoint_behind_a_wall_is_dropped() {
+    let mut store = ChunkStore::new(&config());
+    for x in -25..=25 {
+        for y in -25..=25 {
+            set(&mut store, IVec3::new(x, y, 10), VoxelState::Free);
+        }
+    }
+    // A wall voxel 1 m east of the centroid, between it and its eastern viewpoint only.
+    set(&mut store, IVec3::new(10, 0, 10), VoxelState::Occupied);
+    assert!(!in_sight(&store, Vec3::new(2.05, 0.05, 1.05), CENTROID));
+    assert!(in_sight(&store, Vec3::new(-1.95, 0.05, 1.05), CENTROID));
+    let vps = standoff_viewpoints(&store, CENTROID, 2.0, 0.0, CENTROID);
+    assert_eq!(vps.len(), 7, "{vps:?}");
+    assert!(
+        vps.iter()
+            .all(|v| v.position.y != CENTROID.y || v.position.x < 0.0),
+        "{vps:?}"
+    );
+    // Unknown voxels do not block the sight.
+    set(&mut store, IVec3::new(10, 0, 10), VoxelState::Unknown);
+    assert!(in_sight(&store, Vec3::new(2.05, 0.05, 1.05), CENTROID));
+}

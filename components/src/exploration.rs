@@ -128,7 +128,8 @@ pub struct NeedsDecision;
 pub struct CandidateTrajectory {
     pub trajectory: Arc<PiecewisePolynomial>,
     /// Where it ends (the cluster's centroid, or the viewpoint the planner had to fall back
-    /// to) and the heading there.
+    /// to; with `ExplorerSettings::standoff_m` a standoff viewpoint, or the centroid as the
+    /// fallback) and the heading there.
     pub goal: Vec3,
     pub goal_yaw: f32,
     /// Information gain IG(c) = the cluster's frontier voxels (eaae.md step 5).
@@ -137,7 +138,8 @@ pub struct CandidateTrajectory {
     pub centroid_distance_m: f32,
     /// Length of the searched, shortened path (m).
     pub path_length_m: f32,
-    /// Which goal was planned to: `None` the centroid, `Some(i)` viewpoint `i`.
+    /// Which goal was planned to: `None` the centroid, `Some(i)` viewpoint `i` (of the
+    /// cluster's `Viewpoints`, or with the standoff option of its standoff viewpoints).
     pub viewpoint: Option<usize>,
 }
 

@@ -177,9 +177,11 @@ pub fn with_standoff(
     targets
         .iter()
         .map(|target| ClusterTarget {
+            entity: target.entity,
+            centroid: target.centroid,
+            size: target.size,
             viewpoints: standoff_viewpoints(map, target.centroid, distance, clearance, from),
             centroid_first: false,
-            ..target.clone()
         })
         .collect()
 }

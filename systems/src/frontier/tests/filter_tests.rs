@@ -100,14 +100,21 @@ fn viewpoints_outside_or_at_the_edge_of_the_map_are_dropped() {
     assert!(is_clear(&store, Vec3::new(0.05, 0.05, -2.85), 0.25));
 }
 
-#[test]
-fn yaw_faces_the_centroid() {
+/// A map whose only known voxels are the free ones of layer z = 10 (the centroid's) within
+/// `half` voxels of the centroid's voxel on x and y.
+fn free_layer(half: i32) -> ChunkStore {
     let mut store = ChunkStore::new(&config());
-    for x in -10..=10 {
-        for y in -10..=10 {
+    for x in -half..=half {
+        for y in -half..=half {
             set(&mut store, IVec3::new(x, y, 10), VoxelState::Free);
         }
     }
+    store
+}
+
+#[test]
+fn yaw_faces_the_centroid() {
+    let store = free_layer(10);
     let settings = ClusterSettings {
         viewpoint_clearance_m: 0.0,
         ..ClusterSettings::default()
@@ -197,12 +204,7 @@ fn matching_keeps_the_nearest_old_cluster_within_half_r_max() {
 
 #[test]
 fn standoff_viewpoints_face_the_centroid_from_their_distance_nearest_first() {
-    let mut store = ChunkStore::new(&config());
-    for x in -25..=25 {
-        for y in -25..=25 {
-            set(&mut store, IVec3::new(x, y, 10), VoxelState::Free);
-        }
-    }
+    let mut store = free_layer(25);
     // The UAV west of the centroid.
     let from = CENTROID - Vec3::new(5.0, 0.0, 0.0);
     let vps = standoff_viewpoints(&store, CENTROID, 2.0, 0.0, from);
@@ -238,12 +240,7 @@ fn standoff_viewpoints_face_the_centroid_from_their_distance_nearest_first() {
 
 #[test]
 fn a_standoff_viewpoint_behind_a_wall_is_dropped() {
-    let mut store = ChunkStore::new(&config());
-    for x in -25..=25 {
-        for y in -25..=25 {
-            set(&mut store, IVec3::new(x, y, 10), VoxelState::Free);
-        }
-    }
+    let mut store = free_layer(25);
     // A wall voxel 1 m east of the centroid, between it and its eastern viewpoint only.
     set(&mut store, IVec3::new(10, 0, 10), VoxelState::Occupied);
     assert!(!in_sight(&store, Vec3::new(2.05, 0.05, 1.05), CENTROID));

@@ -464,6 +464,8 @@ mod tests {
             "every centroid of the room is feasible"
         );
         let viewpoint_goals = evaluate(&inputs, &standoff, at, CandidateScope::All).candidates;
+        // The cluster in the closed pocket stays infeasible: its standoff viewpoints outside
+        // the pocket are not in sight of its centroid.
         assert_eq!(viewpoint_goals.len(), centroid_goals.len());
         for evaluated in &viewpoint_goals {
             let candidate = &evaluated.candidate;

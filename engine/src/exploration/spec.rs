@@ -16,7 +16,8 @@
 //! energy_budget = { reserve_j = 5000.0 }   # optional: return home before the battery runs low
 //! standoff_m = 2.5           # optional, beyond the thesis: fly to a viewpoint this far from
 //!                            # a cluster's centroid, level with it and facing it, before
-//!                            # trying the centroid (absent: the thesis' centroid first)
+//!                            # trying the centroid (absent: the thesis' centroid first);
+//!                            # at most the depth camera's range_max
 //! ```
 //! Everything but `strategy` has the default shown.
 

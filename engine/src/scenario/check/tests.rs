@@ -250,6 +250,17 @@ fn explore_settings() {
         one(&explore("standoff_m = 0.0")),
         finding("uav[0].behaviour.standoff_m", "must be above 0", "0.0")
     );
+    // The base scenario's camera reaches 5 m (the default range_max).
+    assert_eq!(findings(&explore("standoff_m = 5.0")), vec![]);
+    assert_eq!(
+        one(&explore("standoff_m = 5.5")),
+        finding(
+            "uav[0].behaviour.standoff_m",
+            "must be at most the depth camera's range_max, 5.0 m (a viewpoint farther off \
+             cannot see its cluster's centroid)",
+            "5.5"
+        )
+    );
     assert_eq!(
         one(&explore("candidates = 0")),
         finding("uav[0].behaviour.candidates", "must be at least 1", "0")

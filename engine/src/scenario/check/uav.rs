@@ -8,6 +8,7 @@ use super::{
     non_negative, positive, triple,
 };
 use crate::exploration::CandidateCount;
+use crate::exploration::setup::camera_of;
 use crate::scenario::diagnostic::{Finding, number};
 use crate::scenario::path::FieldPath;
 use crate::scenario::schema::{
@@ -118,6 +119,21 @@ pub(crate) fn check_uav(
         out,
     );
     check_behaviour(&path.key("behaviour"), &uav.behaviour, context, out);
+    // A standoff viewpoint farther off than the camera reaches cannot see its cluster.
+    if let BehaviourSpec::Explore(explore) = &uav.behaviour
+        && let (Some(standoff), Some((_, range))) = (explore.standoff_m, camera_of(uav))
+        && standoff > range
+    {
+        out.push(Finding::must_be(
+            path.key("behaviour").key("standoff_m"),
+            format!(
+                "at most the depth camera's range_max, {} m (a viewpoint farther off cannot \
+                 see its cluster's centroid)",
+                number(range)
+            ),
+            number(standoff),
+        ));
+    }
 }
 
 fn within(bounds: &BoundsSpec) -> String {

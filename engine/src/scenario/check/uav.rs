@@ -119,13 +119,25 @@ pub(crate) fn check_uav(
         out,
     );
     check_behaviour(&path.key("behaviour"), &uav.behaviour, context, out);
-    // A standoff viewpoint farther off than the camera reaches cannot see its cluster.
-    if let BehaviourSpec::Explore(explore) = &uav.behaviour
-        && let (Some(standoff), Some((_, range))) = (explore.standoff_m, camera_of(uav))
+    check_standoff(&path.key("behaviour").key("standoff_m"), uav, out);
+}
+
+/// An exploring UAV's `standoff_m`: above 0, and within its depth camera's range (a viewpoint
+/// farther off cannot see its cluster). Here rather than in [`check_behaviour`]: it needs the
+/// UAV's sensors.
+fn check_standoff(path: &FieldPath, uav: &UavSpec, out: &mut Vec<Finding>) {
+    let BehaviourSpec::Explore(explore) = &uav.behaviour else {
+        return;
+    };
+    let Some(standoff) = explore.standoff_m else {
+        return;
+    };
+    positive(out, path.clone(), standoff);
+    if let Some((_, range)) = camera_of(uav)
         && standoff > range
     {
         out.push(Finding::must_be(
-            path.key("behaviour").key("standoff_m"),
+            path.clone(),
             format!(
                 "at most the depth camera's range_max, {} m (a viewpoint farther off cannot \
                  see its cluster's centroid)",
@@ -176,9 +188,6 @@ fn check_behaviour(
         }
         BehaviourSpec::Explore(explore) => {
             positive(out, path.key("replan_hz"), explore.replan_hz);
-            if let Some(standoff) = explore.standoff_m {
-                positive(out, path.key("standoff_m"), standoff);
-            }
             if let CandidateCount::Count(n) = explore.candidates {
                 at_least_one(out, path.key("candidates"), n);
             }

@@ -46,6 +46,34 @@ impl WorldGeometry {
         self.first_intersecting(&Pose::from_translation(center), &Ball::new(radius), center)
     }
 
+    /// The first obstacle touched by the ball that also reaches into `region` (an obstacle
+    /// merely touching its faces does not), if any. Conservative: the obstacle need not touch
+    /// the ball inside `region`. Why: a space the map and planner know only inside their box
+    /// (an explorer's start capsule) contradicts no obstacle that stays outside the box, such
+    /// as the ground slab under a map whose floor is z = 0.
+    pub fn obstacle_intersecting_ball_within(
+        &self,
+        center: Vec3,
+        radius: f32,
+        region: &Aabb,
+    ) -> Option<usize> {
+        if self.obstacles.is_empty() {
+            return None;
+        }
+        let ball = Ball::new(radius);
+        let pose = Pose::from_translation(center);
+        let inside = Cuboid::new(region.half_extents());
+        let inside_pose = Pose::from_translation(region.center());
+        self.bvh
+            .intersect_aabb(&ball.compute_aabb(&pose))
+            .map(|leaf| leaf as usize)
+            .find(|&i| {
+                let obstacle = &self.obstacles[i];
+                shape_intersects(&pose, &ball, center, obstacle)
+                    && shape_intersects(&inside_pose, &inside, region.center(), obstacle)
+            })
+    }
+
     /// Ground truth of one voxel: whether the cube centred at `center` with edge `edge`, shrunk
     /// by [`VOXEL_SHRINK`] of the edge on every side, overlaps an obstacle. A face of an obstacle
     /// that merely touches the voxel does not count; a voxel wholly inside a solid does.

@@ -245,6 +245,43 @@ fn points_and_balls_against_box_cylinder_and_closed_mesh() {
     );
 }
 
+/// A ball counts an obstacle only if the obstacle reaches into the region: the slab under a
+/// region whose floor is z = 0 touches its face and does not, a box standing in it does.
+#[test]
+fn balls_against_the_obstacles_that_reach_into_a_region() {
+    let w = world(vec![
+        box_obstacle(
+            "slab",
+            Vec3::new(0.0, 0.0, -0.5),
+            Vec3::new(20.0, 20.0, 1.0),
+            0.0,
+        ),
+        box_obstacle(
+            "box",
+            Vec3::new(3.0, 0.0, 1.0),
+            Vec3::new(1.0, 1.0, 2.0),
+            0.0,
+        ),
+    ]);
+    let region = Aabb::new(Vec3::new(-5.0, -5.0, 1e-4), Vec3::new(5.0, 5.0, 2.5));
+    let within = |c: Vec3, r: f32| w.obstacle_intersecting_ball_within(c, r, &region);
+    // A ball reaching 0.2 m below the floor: the slab alone, outside the region.
+    assert_eq!(
+        w.obstacle_intersecting_ball(Vec3::new(0.0, 0.0, 1.0), 1.2),
+        Some(0)
+    );
+    assert_eq!(within(Vec3::new(0.0, 0.0, 1.0), 1.2), None);
+    // Reaching the box's face as well (at x = 2.5, 0.3 m off): the box.
+    assert_eq!(within(Vec3::new(1.3, 0.0, 1.0), 1.5), Some(1));
+    assert_eq!(within(Vec3::new(1.0, 0.0, 1.0), 1.4), None);
+    // With the region's floor below the slab's top, the slab reaches into it.
+    let lower = Aabb::new(Vec3::new(-5.0, -5.0, -0.5), Vec3::new(5.0, 5.0, 2.5));
+    assert_eq!(
+        w.obstacle_intersecting_ball_within(Vec3::new(0.0, 0.0, 1.0), 1.2, &lower),
+        Some(0)
+    );
+}
+
 #[test]
 fn open_mesh_is_a_shell_only() {
     // Without ORIENTED the cube is 12 thin triangles: its inside is free space.

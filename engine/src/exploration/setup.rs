@@ -8,6 +8,7 @@ use crate::scenario::{BehaviourSpec, SensorSpec, UavSpec};
 use crate::world::BuildError;
 use bevy_ecs::prelude::*;
 use glam::{DVec3, IVec3};
+use parry3d::bounding_volume::Aabb;
 use parry3d::shape::Capsule;
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
@@ -17,7 +18,7 @@ use uavex_components::exploration::{
 use uavex_components::frontier::ClusterSettings;
 use uavex_components::map::MapConfig;
 use uavex_components::trajectory::Hold;
-use uavex_components::world::WorldGeometry;
+use uavex_components::world::{VOXEL_SHRINK, WorldGeometry};
 use uavex_systems::behaviour::waypoints::CLEARANCE_MARGIN_M;
 use uavex_systems::exploration::strategy::{
     ClassicStrategy, EaaeStrategy, NearestStrategy, TourStrategy, choose_by_tour,
@@ -27,7 +28,7 @@ use uavex_systems::exploration::{
     DecideStep, add_exploration_systems, insert_exploration_resources,
 };
 use uavex_systems::frontier::insert_frontier_resources;
-use uavex_systems::planning::{Traversability, TraversableGrid};
+use uavex_systems::planning::{Traversability, TraversableGrid, inflation_radius};
 
 /// The horizontal field of view (rad) and range (m) of the UAV's first depth camera: the
 /// clustering stop rule and the planning horizon are made for it (eaae.md steps 2 and 9).
@@ -107,7 +108,7 @@ impl StartCapsule {
             DVec3::from_array(spec.start.position),
             spec.start.yaw,
             camera.vfov,
-            inflation_of(airframe),
+            inflation_of(airframe, resolution),
             resolution,
         )
     }
@@ -124,9 +125,10 @@ impl StartCapsule {
     }
 }
 
-/// The planner's inflation radius for an airframe (its radius and the tour's margin).
-pub fn inflation_of(airframe: &Airframe) -> f64 {
-    airframe.bounding_radius() + CLEARANCE_MARGIN_M
+/// The planner's inflation radius for an airframe on a map of `resolution`: its radius and the
+/// tour's margin, or one voxel if that is larger ([`inflation_radius`]).
+pub fn inflation_of(airframe: &Airframe, resolution: f64) -> f64 {
+    inflation_radius(airframe.bounding_radius(), CLEARANCE_MARGIN_M, resolution)
 }
 
 /// The components of an exploring `uav[index]`: the true flight hovering at its start, its
@@ -153,29 +155,35 @@ pub fn explorer_components(
     let start = DVec3::from_array(spec.start.position);
     let capsule = StartCapsule::ahead_of(spec, &camera, airframe, resolution);
     // Seeded pillar fields keep the capsule clear by themselves; any other obstacle in it is
-    // the scenario's to move.
-    if capsule
-        .centres(resolution)
-        .any(|c| geometry.intersects_ball(c.as_vec3(), capsule.radius as f32))
-    {
+    // the scenario's to move. Only obstacles that reach into the map count: the planner takes
+    // the capsule as free only inside the map, and everything outside as occupied (so the
+    // ground slab under a map whose floor is z = 0 never contradicts it, however low the start).
+    let map_min = map.key_min().as_dvec3() * resolution;
+    let map_max = (map.key_max() + IVec3::ONE).as_dvec3() * resolution;
+    let shrink = f64::from(VOXEL_SHRINK) * resolution;
+    let map_box = Aabb::new((map_min + shrink).as_vec3(), (map_max - shrink).as_vec3());
+    if let Some(obstacle) = capsule.centres(resolution).find_map(|c| {
+        geometry.obstacle_intersecting_ball_within(c.as_vec3(), capsule.radius as f32, &map_box)
+    }) {
+        let obstacle = &geometry.obstacles()[obstacle];
         return Err(BuildError::new(
             format!("uav[{index}].start.position"),
             format!(
                 "an exploring UAV needs clear space around its start: {:.2} m around the \
                  line from the start {:.2} m ahead along its heading (its body, the planner's \
-                 margin, and what its camera cannot see beside and below it); an obstacle \
-                 lies closer",
+                 margin, and what its camera cannot see beside and below it); obstacle '{}' \
+                 ({}) lies closer",
                 capsule.radius,
-                capsule.from.distance(capsule.to)
+                capsule.from.distance(capsule.to),
+                obstacle.name,
+                obstacle.source
             ),
         ));
     }
     // The planner counts voxels outside the map as occupied (`TraversableGrid`): from a start
     // nearer a face of the map than its inflation radius no path leaves the start, and every
     // cluster would look unreachable (a run that ends `complete` at once).
-    let inflation = inflation_of(airframe);
-    let map_min = map.key_min().as_dvec3() * resolution;
-    let map_max = (map.key_max() + IVec3::ONE).as_dvec3() * resolution;
+    let inflation = inflation_of(airframe, resolution);
     let clearance = (start - map_min).min(map_max - start).min_element();
     if clearance < inflation {
         let corner = |p: DVec3| format!("({:.2}, {:.2}, {:.2})", p.x, p.y, p.z);
@@ -275,7 +283,7 @@ pub fn add_exploration(
     let map = world.resource::<MapConfig>().clone();
     let inflation = airframes
         .iter()
-        .map(|a| inflation_of(a))
+        .map(|a| inflation_of(a, map.resolution()))
         .fold(0.0, f64::max);
     insert_frontier_resources(world, ClusterSettings::for_camera(camera.0, camera.1));
     let mut grid = TraversableGrid::new(&map, inflation);

@@ -46,7 +46,7 @@ pub use global::{GlobalPlan, plan_along, plan_along_seen, plan_global};
 pub use local::{LocalPlan, plan_local};
 pub use search::{PathSearch, SNAP_RADIUS_M, find_path, find_paths, path_length, shortcut};
 pub use sight::SightMemo;
-pub use traversable::TraversableGrid;
+pub use traversable::{TraversableGrid, inflation_radius};
 
 use crate::mapping::{StateChange, StateChanges};
 use bevy_ecs::prelude::*;

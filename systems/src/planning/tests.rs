@@ -19,8 +19,12 @@ pub(super) struct TestMap {
 
 impl TestMap {
     pub fn new(min: DVec3, max: DVec3) -> Self {
+        Self::with_resolution(min, max, 0.1)
+    }
+
+    pub fn with_resolution(min: DVec3, max: DVec3, resolution: f64) -> Self {
         let config = MapConfig::new(&MapSettings {
-            resolution: 0.1,
+            resolution,
             bounds_min: min,
             bounds_max: max,
             ..MapSettings::default()
@@ -162,6 +166,42 @@ fn inflation_blocks_exactly_the_ball_and_the_box_border() {
     assert!(grid.is_traversable_point(DVec3::new(1.95, 1.65, 1.65)));
     assert!(!grid.is_traversable_point(DVec3::new(1.85, 1.65, 1.65)));
     assert!(!grid.is_traversable_point(DVec3::new(f64::NAN, 1.0, 1.0)));
+}
+
+/// Face-on to a wall, every traversable voxel keeps the body's radius between its box and the
+/// box of every wall voxel, whatever the resolution: the wall's face may lie anywhere in its
+/// voxels, the UAV anywhere in its own. (With the margin fixed at 0.1 m this fails at 0.2 m,
+/// where the voxel two off the wall is traversable 0.2 m from it, under the kingfisher's
+/// 0.22 m, and at 0.4 m.)
+#[test]
+fn the_inflation_keeps_the_body_off_a_wall_at_any_resolution() {
+    let body = uavex_components::airframe::Airframe::kingfisher().bounding_radius();
+    for resolution in [0.05, 0.1, 0.15, 0.2, 0.3, 0.4] {
+        let mut map = TestMap::with_resolution(DVec3::ZERO, DVec3::new(6.0, 2.0, 2.0), resolution);
+        map.fill_all(FREE);
+        let wall = map.config.key_max().x / 2;
+        let (min, max) = (map.config.key_min(), map.config.key_max());
+        map.fill(
+            IVec3::new(wall, min.y, min.z),
+            IVec3::new(wall, max.y, max.z),
+            OCCUPIED,
+        );
+        let grid = map.grid(inflation_radius(body, 0.1, resolution));
+        let middle = (min + max) / 2;
+        let mut traversable = 0;
+        for x in min.x..=max.x {
+            let key = IVec3::new(x, middle.y, middle.z);
+            if grid.is_traversable(key) {
+                traversable += 1;
+                let gap = f64::from((x - wall).abs() - 1) * resolution;
+                assert!(
+                    gap >= body - 1e-9,
+                    "{resolution} m: voxel {key} is traversable {gap:.2} m from the wall"
+                );
+            }
+        }
+        assert!(traversable > 0, "{resolution} m: nothing traversable");
+    }
 }
 
 #[test]

@@ -11,6 +11,9 @@
 //!   face it had never looked at: flying along a face, the camera looks ahead and the face
 //!   beside the path stays unknown), except for lone unknown voxels: the holes a matched ray
 //!   grid leaves between its rays in space it has seen, which would otherwise block all of it.
+//! - The inflation radius is the body's radius and a margin of at least one voxel
+//!   ([`inflation_radius`]): distances between voxel centres can understate the true gap
+//!   between the UAV and an obstacle face by half a voxel on each side.
 //! - Voxels **outside the map box count as occupied** for inflation: the boxes hug the
 //!   enclosure walls, whose surface hits may fall just outside the box. (There is no ceiling in
 //!   the EAAE scenes; staying a radius below the box top is harmless.)
@@ -36,6 +39,18 @@ use uavex_components::map::{CHUNK_EDGE, ChunkCoord, ChunkGrid, MapConfig, floor_
 pub const MAX_INFLATION_VOXELS: i32 = 23;
 const EDGE: i32 = CHUNK_EDGE;
 const ROWS: usize = (CHUNK_EDGE * CHUNK_EDGE) as usize;
+
+/// The inflation radius (m) for a body of `body_radius_m` on a map of `resolution`: the radius
+/// and a margin of `margin_m` or one voxel, whichever is larger.
+///
+/// Why at least a voxel: traversability is measured between voxel centres, and face-on to an
+/// obstacle a centre lies up to half a voxel from the UAV inside its voxel, and the obstacle's
+/// face up to half a voxel from the centre of its own. A margin of one voxel keeps the body off
+/// the face whatever the resolution; the tour's 0.1 m margin did so at the thesis' 0.1 m map,
+/// not at 0.2 m (7 of 96 missions crashed there, each into a wall or trunk it had mapped).
+pub fn inflation_radius(body_radius_m: f64, margin_m: f64, resolution: f64) -> f64 {
+    body_radius_m + margin_m.max(resolution)
+}
 
 /// Traversable flags of one chunk: `rows[y + 16 z]` bit `x` (local coordinates).
 type ChunkRows = [u16; ROWS];

@@ -57,21 +57,14 @@ impl WorldGeometry {
         radius: f32,
         region: &Aabb,
     ) -> Option<usize> {
-        if self.obstacles.is_empty() {
-            return None;
-        }
-        let ball = Ball::new(radius);
-        let pose = Pose::from_translation(center);
         let inside = Cuboid::new(region.half_extents());
         let inside_pose = Pose::from_translation(region.center());
-        self.bvh
-            .intersect_aabb(&ball.compute_aabb(&pose))
-            .map(|leaf| leaf as usize)
-            .find(|&i| {
-                let obstacle = &self.obstacles[i];
-                shape_intersects(&pose, &ball, center, obstacle)
-                    && shape_intersects(&inside_pose, &inside, region.center(), obstacle)
-            })
+        self.first_intersecting_where(
+            &Pose::from_translation(center),
+            &Ball::new(radius),
+            center,
+            |obstacle| shape_intersects(&inside_pose, &inside, region.center(), obstacle),
+        )
     }
 
     /// Ground truth of one voxel: whether the cube centred at `center` with edge `edge`, shrunk
@@ -110,6 +103,17 @@ impl WorldGeometry {
     /// The first obstacle intersecting `shape` at `pose`; `center` is a point inside the shape,
     /// used for the inside test of closed meshes.
     fn first_intersecting(&self, pose: &Pose, shape: &dyn Shape, center: Vec3) -> Option<usize> {
+        self.first_intersecting_where(pose, shape, center, |_| true)
+    }
+
+    /// [`Self::first_intersecting`] among the obstacles that `keep` accepts.
+    fn first_intersecting_where(
+        &self,
+        pose: &Pose,
+        shape: &dyn Shape,
+        center: Vec3,
+        keep: impl Fn(&Obstacle) -> bool,
+    ) -> Option<usize> {
         if self.obstacles.is_empty() {
             return None;
         }
@@ -117,7 +121,10 @@ impl WorldGeometry {
         self.bvh
             .intersect_aabb(&aabb)
             .map(|leaf| leaf as usize)
-            .find(|&i| shape_intersects(pose, shape, center, &self.obstacles[i]))
+            .find(|&i| {
+                let obstacle = &self.obstacles[i];
+                shape_intersects(pose, shape, center, obstacle) && keep(obstacle)
+            })
     }
 }
 

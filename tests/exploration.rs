@@ -359,7 +359,9 @@ fn the_start_capsule_is_checked_against_obstacles_inside_the_map() {
 
 /// On a 0.2 m map, clearance measured between voxel centres understates a gap by up to a voxel;
 /// with the thesis' 0.1 m margin, this Classic mission in the forest crashed into a trunk at
-/// 61.7 s (as 6 other of 96 missions at 0.2 m did). With a margin of a voxel it flies on.
+/// 61.7 s (as 6 other of 96 missions at 0.2 m did): its map held one voxel of the trunk at the
+/// UAV's height, 0.4 m from the UAV's voxel, outside the 0.32 m inflation and inside 0.42 m.
+/// With a margin of a voxel it flies on.
 #[test]
 fn a_coarse_map_keeps_the_body_off_what_it_mapped() {
     let mut loaded = scene("eaae_forest.toml", StrategyName::Classic);

@@ -314,10 +314,7 @@ fn every_seed_of_a_forest_leaves_the_explorers_start_capsule_clear() {
 fn a_start_within_the_planning_radius_of_the_map_is_refused() {
     let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);
     loaded.scenario.uavs[0].start.position = [0.0, 0.0, 2.3];
-    let Err(error) = Sim::build(&loaded, 1) else {
-        panic!("a start 0.20 m below the map's top was accepted");
-    };
-    let error = error.to_string();
+    let error = refused(&loaded, "a start 0.20 m below the map's top");
     assert!(
         error.contains("uav[0].start.position")
             && error.contains("planning radius, 0.320 m")
@@ -345,10 +342,7 @@ fn the_start_capsule_is_checked_against_obstacles_inside_the_map() {
     // 0.6 m in front of pillar 1's north face, facing it.
     loaded.scenario.uavs[0].start.position = [-0.3643, -4.8, 1.0];
     loaded.scenario.uavs[0].start.yaw = -std::f64::consts::FRAC_PI_2;
-    let Err(error) = Sim::build(&loaded, 1) else {
-        panic!("a start 0.6 m from a pillar, facing it, was accepted");
-    };
-    let error = error.to_string();
+    let error = refused(&loaded, "a start 0.6 m from a pillar, facing it");
     assert!(
         error.contains("uav[0].start.position")
             && error.contains("needs clear space around its start")
@@ -370,6 +364,14 @@ fn a_coarse_map_keeps_the_body_off_what_it_mapped() {
     let mut sim = Sim::build(&loaded, 108).unwrap_or_else(|e| panic!("{e}"));
     let (outcome, reason) = sim.run_to_end();
     assert_eq!(outcome, Outcome::TimeLimit, "{reason}");
+}
+
+/// The error with which building `loaded` (seed 1) is refused; panics if `case` is accepted.
+fn refused(loaded: &LoadedScenario, case: &str) -> String {
+    match Sim::build(loaded, 1) {
+        Ok(_) => panic!("{case} was accepted"),
+        Err(error) => error.to_string(),
+    }
 }
 
 /// Runs `loaded` (seed 1) to its time limit and asserts it got there flying to frontier.

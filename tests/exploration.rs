@@ -31,6 +31,10 @@ use uavex::systems::exploration::strategy::{
 };
 use uavex::systems::mapping::MapReader;
 
+/// The goal options beyond the thesis: the standoff and the frontier viewpoint.
+#[path = "exploration/goal_options.rs"]
+mod goal_options;
+
 /// A shipped scene with its UAV exploring by `strategy`.
 fn scene(file: &str, strategy: StrategyName) -> LoadedScenario {
     let mut loaded = load(format!("{}/scenarios/{file}", env!("CARGO_MANIFEST_DIR")))
@@ -43,6 +47,7 @@ fn scene(file: &str, strategy: StrategyName) -> LoadedScenario {
         replan_hz: 2.0,
         energy_budget: None,
         standoff_m: None,
+        frontier_viewpoint: false,
     });
     loaded
 }
@@ -190,55 +195,6 @@ fn reachable_explored(sim: &mut Sim) -> (ReachableVolume, f64) {
     let mut reader = SystemState::<MapReader>::new(world);
     let explored = volume.explored_pct(&reader.get(world).unwrap());
     (volume, explored)
-}
-
-/// With the standoff option (beyond the thesis) a goal is a viewpoint 2.5 m from its
-/// cluster's centroid, level with it, unless no viewpoint had a feasible trajectory (then the
-/// centroid, as eaae.md step 6 plans); the mission still explores Pillars to the end.
-#[test]
-fn standoff_goals_view_their_clusters_from_a_distance() {
-    let mut loaded = scene("eaae_pillars.toml", StrategyName::Eaae);
-    if let BehaviourSpec::Explore(explore) = &mut loaded.scenario.uavs[0].behaviour {
-        explore.standoff_m = Some(2.5);
-    }
-    let mut sim = Sim::build(&loaded, 1).unwrap_or_else(|e| panic!("{e}"));
-    let (outcome, reason) = sim.run_to_end();
-    assert_eq!(outcome, Outcome::Complete, "{reason}");
-    let log = sim.world.resource::<DecisionLog>();
-    let goals: Vec<_> = log
-        .decisions
-        .iter()
-        .filter_map(|d| d.chosen.map(|i| &d.candidates[i]))
-        .collect();
-    let off = |c: &&CandidateRecord| {
-        let [gx, gy, gz] = c.goal;
-        let [cx, cy, cz] = c.centroid;
-        ((gx - cx).hypot(gy - cy), (gz - cz).abs())
-    };
-    // A goal the planner could not reach exactly ends at the nearest traversable point (a
-    // centroid near the floor, say), within a voxel layer or a few of it.
-    let exactly_at_standoff = goals
-        .iter()
-        .filter(|c| {
-            let (horizontal, vertical) = off(c);
-            (horizontal - 2.5).abs() < 1e-3 && vertical < 1e-3
-        })
-        .count();
-    let near_standoff_or_centroid = goals
-        .iter()
-        .filter(|c| {
-            let (horizontal, vertical) = off(c);
-            (horizontal - 2.5).abs() < 0.5 || horizontal.hypot(vertical) < 1.0
-        })
-        .count();
-    assert_eq!(near_standoff_or_centroid, goals.len());
-    assert!(
-        goals.len() >= 20 && exactly_at_standoff * 4 >= goals.len() * 3,
-        "{exactly_at_standoff} of {} goals at the standoff",
-        goals.len()
-    );
-    let (_, explored) = reachable_explored(&mut sim);
-    assert!(explored >= 95.0, "{explored}");
 }
 
 /// Round trunks leave frontier voxels around their insides that no flight clears; before they

@@ -48,6 +48,10 @@ pub struct ExplorerSettings {
     /// its viewpoints 0.5 m off; eaae.md step 6). See
     /// `uavex_systems::frontier::standoff_viewpoints`.
     pub standoff_m: Option<f32>,
+    /// Beyond the thesis: after a cluster's viewpoints, try its frontier voxel nearest to its
+    /// centroid (`false`: the thesis' goals alone; eaae.md steps 4 and 6). See
+    /// `uavex_systems::frontier::frontier_viewpoint`.
+    pub frontier_viewpoint: bool,
 }
 
 impl ExplorerSettings {
@@ -66,6 +70,7 @@ impl ExplorerSettings {
             budget: None,
             interior_search_m: range_max_m as f32,
             standoff_m: None,
+            frontier_viewpoint: false,
         }
     }
 }

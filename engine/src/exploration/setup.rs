@@ -212,6 +212,7 @@ pub fn explorer_components(
         reserve_j: b.reserve_j,
     });
     settings.standoff_m = explore.standoff_m.map(|d| d as f32);
+    settings.frontier_viewpoint = explore.frontier_viewpoint;
     let explorer = Explorer {
         settings,
         home: start.as_vec3(),

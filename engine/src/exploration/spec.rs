@@ -18,6 +18,9 @@
 //!                            # a cluster's centroid, level with it and facing it, before
 //!                            # trying the centroid (absent: the thesis' centroid first);
 //!                            # at most the depth camera's range_max
+//! frontier_viewpoint = false # beyond the thesis: after a cluster's viewpoints, try its
+//!                            # frontier voxel nearest to its centroid (for cameras whose
+//!                            # clusters are large: see the README)
 //! ```
 //! Everything but `strategy` has the default shown.
 
@@ -102,6 +105,10 @@ pub struct ExploreSpec {
     /// thesis' goals.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub standoff_m: Option<f64>,
+    /// Whether a cluster's frontier voxel nearest to its centroid is tried after its
+    /// viewpoints (`ExplorerSettings::frontier_viewpoint`).
+    #[serde(default)]
+    pub frontier_viewpoint: bool,
 }
 
 fn default_candidates() -> CandidateCount {

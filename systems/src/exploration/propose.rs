@@ -15,12 +15,12 @@ use super::evaluate::{
 };
 use crate::flight::ecs::{FlightEnergy, ReferenceTrajectory};
 use crate::flight::{Completion, FlightState, RolloutConfig};
-use crate::frontier::standoff_viewpoints;
+use crate::frontier::{frontier_viewpoint, standoff_viewpoints};
 use crate::mapping::{MapReader, OccupancyMap};
 use crate::planning::{GlobalPlan, Traversability, TraversableGrid};
 use crate::trajectory::DynamicLimits;
 use bevy_ecs::prelude::*;
-use glam::{DVec3, Vec3};
+use glam::{DVec3, IVec3, Vec3};
 use std::sync::Arc;
 use uavex_components::airframe::Airframe;
 use uavex_components::exploration::{
@@ -28,8 +28,9 @@ use uavex_components::exploration::{
     NeedsDecision, PredictedDuration, PredictedEnergy, Toward, Unaffordable,
 };
 use uavex_components::frontier::{
-    ClusterSettings, FrontierCluster, Reachable, Viewpoint, Viewpoints,
+    ClusterMembers, ClusterSettings, FrontierCluster, Reachable, Viewpoint, Viewpoints,
 };
+use uavex_components::map::MapConfig;
 use uavex_components::sim::SimClock;
 use uavex_components::trajectory::TrajectoryPoint;
 use uavex_components::uav::QuadState;
@@ -186,6 +187,27 @@ pub fn with_standoff(
         .collect()
 }
 
+/// `targets` with each cluster's frontier voxel nearest to its centroid ([`frontier_viewpoint`]
+/// of its `members`) added after its viewpoints (the option beyond the thesis:
+/// `ExplorerSettings::frontier_viewpoint`). With the standoff option the centroid is still
+/// tried last.
+pub fn with_frontier_viewpoints<'m>(
+    targets: &[ClusterTarget],
+    config: &MapConfig,
+    members: impl Fn(Entity) -> Option<&'m [IVec3]>,
+) -> Vec<ClusterTarget> {
+    targets
+        .iter()
+        .map(|target| {
+            let mut target = target.clone();
+            let nearest = members(target.entity)
+                .and_then(|keys| frontier_viewpoint(config, target.centroid, keys));
+            target.viewpoints.extend(nearest);
+            target
+        })
+        .collect()
+}
+
 /// Candidates of this decision, for the commit (how many clusters it saw, its timings, the
 /// way home when nothing was affordable).
 #[derive(Component, Debug, Clone)]
@@ -196,7 +218,7 @@ pub struct PendingDecision {
 }
 
 /// Propose step: candidate entities for every UAV that needs a decision.
-#[allow(clippy::type_complexity)]
+#[allow(clippy::type_complexity, clippy::too_many_arguments)]
 pub fn propose_candidates(
     mut commands: Commands,
     clock: Res<SimClock>,
@@ -215,6 +237,7 @@ pub fn propose_candidates(
         With<NeedsDecision>,
     >,
     clusters: Query<(Entity, &FrontierCluster, &Viewpoints), With<Reachable>>,
+    members: Query<&ClusterMembers>,
     cluster_settings: Res<ClusterSettings>,
 ) {
     if uavs.is_empty() {
@@ -254,6 +277,15 @@ pub fn propose_candidates(
                 standoff = with_standoff(&all, &map, distance, clearance, state.position);
                 &standoff
             }
+        };
+        let with_frontier;
+        let clusters = if settings.frontier_viewpoint {
+            with_frontier = with_frontier_viewpoints(clusters, &map.config, |entity| {
+                members.get(entity).ok().map(|m| m.0.as_slice())
+            });
+            &with_frontier
+        } else {
+            clusters
         };
         let (far, near) = split_too_close(clusters, state.position, settings.min_goal_distance_m);
         let mut evaluation = evaluate(&inputs, &far, state.position, scope);

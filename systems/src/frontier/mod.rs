@@ -22,7 +22,8 @@ pub use assemble::{ClusterData, cluster_frontier, match_clusters};
 pub use cluster::{Cluster, divisive_two_means};
 pub use detect::{chunk_frontier, is_frontier, update_frontier_set};
 pub use filter::{
-    in_sight, is_clear, occupied_near_centroid, sample_viewpoints, standoff_viewpoints,
+    frontier_viewpoint, in_sight, is_clear, occupied_near_centroid, sample_viewpoints,
+    standoff_viewpoints,
 };
 pub use system::{insert_frontier_resources, refresh_clusters, update_frontiers};
 

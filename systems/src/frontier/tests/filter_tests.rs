@@ -256,3 +256,27 @@ fn a_standoff_viewpoint_behind_a_wall_is_dropped() {
     set(&mut store, IVec3::new(10, 0, 10), VoxelState::Unknown);
     assert!(in_sight(&store, Vec3::new(2.05, 0.05, 1.05), CENTROID));
 }
+
+/// The frontier viewpoint (beyond the thesis): the member nearest to the centroid, the first
+/// of equals in the members' order, facing the centroid; none without members.
+#[test]
+fn the_frontier_viewpoint_is_the_member_nearest_to_the_centroid() {
+    let config = config();
+    // On the boundary of voxels (-1, 0, 10) and (0, 0, 10): both centres 0.05 m away.
+    let centroid = Vec3::new(0.0, 0.05, 1.05);
+    let far = IVec3::new(3, 0, 10);
+    let (west, east) = (IVec3::new(-1, 0, 10), IVec3::new(0, 0, 10));
+    let aside = IVec3::new(0, 2, 10);
+    let viewpoint = |members: &[IVec3]| frontier_viewpoint(&config, centroid, members);
+    let v = viewpoint(&[far, west, east, aside]).unwrap();
+    assert_eq!(v.position, config.center_of(west));
+    assert_eq!(v.yaw, 0.0, "from the west voxel the centroid lies along +x");
+    let v = viewpoint(&[far, east, west, aside]).unwrap();
+    assert_eq!(v.position, config.center_of(east));
+    assert_eq!(v.yaw, PI, "from the east voxel the centroid lies along -x");
+    let v = viewpoint(&[far, aside]).unwrap();
+    assert_eq!(v.position, config.center_of(aside));
+    // Toward the centroid: (-0.05, -0.2) m, atan2(-0.2, -0.05) = -1.8158 rad.
+    assert!((v.yaw + 1.815_775).abs() < 1e-5, "{}", v.yaw);
+    assert_eq!(viewpoint(&[]), None);
+}

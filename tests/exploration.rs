@@ -544,6 +544,9 @@ fn shipped_exploration_plan(
             let set = match field.as_str() {
                 "uav.0.behaviour.strategy" => serde_json::to_value(explore.strategy),
                 "uav.0.behaviour.candidates" => serde_json::to_value(explore.candidates),
+                "uav.0.behaviour.frontier_viewpoint" => {
+                    serde_json::to_value(explore.frontier_viewpoint)
+                }
                 other => panic!("{file}: unexpected grid field {other}"),
             };
             let named = serde_json::to_value(value).unwrap();
@@ -585,4 +588,16 @@ fn the_tour_comparison_plan_runs_both_strategies_both_ways() {
         shipped_exploration_plan("tour_comparison.toml", |_| {}).len(),
         40
     );
+}
+
+/// The shipped wide-camera comparison: 4 scenes x 2 strategies x with and without the
+/// frontier viewpoint x 2 seeds.
+#[test]
+fn the_wide_camera_plan_runs_both_strategies_with_and_without_the_frontier_viewpoint() {
+    let plan = shipped_exploration_plan("wide_camera_comparison.toml", |_| {});
+    assert_eq!(plan.len(), 32);
+    let with_option = plan
+        .iter()
+        .filter(|(_, values, _)| values.starts_with("true"));
+    assert_eq!(with_option.count(), 16);
 }

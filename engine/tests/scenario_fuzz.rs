@@ -23,6 +23,7 @@ const SHIPPED_PLANS: &[&str] = &[
     include_str!("../../scenarios/eaae_protocol.toml"),
     include_str!("../../scenarios/tour_comparison.toml"),
     include_str!("../../scenarios/standoff_comparison.toml"),
+    include_str!("../../scenarios/wide_camera_comparison.toml"),
     include_str!("../../docs/sweep_demo.toml"),
     include_str!("../../pgo/training.toml"),
 ];
